@@ -1,0 +1,67 @@
+// The default estimator: least squares on SO(3) of the geodesic residuals |Log(A_j X B_j^T X^T)|^2,
+// started from the paper's two-step iteration (or from the closed form when the two-step has not
+// converged or fits worse), with gross-outlier rejection before the final fit:
+//  1. angle gate: rotation angle is invariant under conjugation, so |angle(A_j) - angle(B_j)| must be
+//     small; the gate is max(angle_gate_min_deg, angle_gate_sigmas * robust spread of the data);
+//  2. consensus: residuals above max(inlier_min_deg, inlier_sigmas * robust sigma) mark outliers;
+//     when there are any, a Cauchy-loss IRLS refit and RANSAC over minimal two-pair solutions look
+//     for a larger consensus;
+//  3. final Gauss-Newton (Levenberg-Marquardt safeguarded) on the inliers with the plain squared loss,
+//     which is the maximum-likelihood estimator for Gaussian noise and reaches the Cramer-Rao bound.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "camera_imu_alignment/rotation_pair.h"
+#include "camera_imu_alignment/two_step_solver.h"
+
+namespace camera_imu_alignment {
+
+struct OptimalOptions {
+  /// Gauss-Newton iteration limit per stage; convergence is tested, not assumed.
+  int max_iterations = 100;
+  /// Converged when the update is smaller than this (rad).
+  double step_tolerance_rad = 1e-12;
+  /// Options of the two-step start.
+  TwoStepOptions two_step;
+  /// Reject pairs whose camera and IMU rotation angles differ by more than
+  /// max(angle_gate_min_deg, angle_gate_sigmas * 1.4826 * median difference).
+  double angle_gate_min_deg = 0.5;
+  double angle_gate_sigmas = 5.0;
+  /// Inlier threshold on |r_j|: max(inlier_min_deg, inlier_sigmas * sigma), sigma = robust per-axis
+  /// residual standard deviation (median |r| / 1.538 for a 3-D Gaussian).
+  double inlier_min_deg = 0.05;
+  double inlier_sigmas = 4.5;
+  /// Number of RANSAC hypotheses (two-pair minimal solutions) when outliers are suspected.
+  int ransac_hypotheses = 300;
+  /// Seed of the RANSAC sampler (results are deterministic).
+  unsigned int seed = 1;
+  /// Set false to fit all pairs (no gate, no consensus).
+  bool reject_outliers = true;
+};
+
+struct OptimalResult {
+  bool valid = false;
+  Eigen::Matrix3d R_cam_imu = Eigen::Matrix3d::Identity();
+  TwoStepResult two_step;      ///< the paper's solver, run on the gated pairs
+  std::string start;           ///< "two_step" or "closed_form"
+  bool converged = false;      ///< final Gauss-Newton stage converged
+  int iterations = 0;          ///< Gauss-Newton iterations, all stages
+  bool ransac_used = false;
+  std::vector<bool> inlier;    ///< per input pair
+  std::vector<std::string> rejection;  ///< per input pair, "" for inliers
+};
+
+/// Estimates R_cam_imu from the pairs (which must be rotation matrices).
+OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& options = {});
+
+/// Gauss-Newton / Levenberg-Marquardt refinement of R_cam_imu on the pairs in `indices`, with the
+/// squared loss (cauchy_scale_rad <= 0) or the Cauchy loss of that scale. Returns the iterations run;
+/// *converged tells whether the step fell below the tolerance.
+int refineRotation(const RotationPairs& pairs, const std::vector<int>& indices,
+                   double cauchy_scale_rad, int max_iterations, double step_tolerance_rad,
+                   Eigen::Matrix3d* R_cam_imu, bool* converged);
+
+}  // namespace camera_imu_alignment

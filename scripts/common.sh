@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# Shared by scripts/demo and scripts/test (sourced, not run): installs the Debian packages this
+# package needs, lays out the git-ignored catkin workspace .ws/ (whose src/camera_imu_alignment links
+# to the repository root) and builds it with catkin_make -j2.
+
+REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+WS="${REPO_ROOT}/.ws"
+
+# Debian's catkin and pluginlib need Debian's own python3 first on PATH (a pyenv python breaks the
+# configure step: "No module named catkin_pkg"). See ../shared/PLATFORM.md.
+export PATH="/usr/bin:/bin:/usr/sbin:/sbin:${PATH}"
+export ROS_HOSTNAME=localhost
+export ROS_HOME="${WS}/ros_home"
+
+CIA_PACKAGES=(
+  build-essential cmake catkin ros-base-dev rosbash python3-rostest python3-rosbag
+  libeigen3-dev libopencv-dev libyaml-cpp-dev libgtest-dev libbenchmark-dev catkin-lint clang-format
+)
+
+cia_log() { echo "[camera_imu_alignment] $*" >&2; }
+
+cia_install_packages() {
+  local missing=() pkg
+  for pkg in "${CIA_PACKAGES[@]}"; do
+    if ! dpkg-query -W -f='${Status}' "${pkg}" 2>/dev/null | grep -q "install ok installed"; then
+      missing+=("${pkg}")
+    fi
+  done
+  if ((${#missing[@]} == 0)); then
+    return 0
+  fi
+  cia_log "installing missing Debian packages: ${missing[*]}"
+  local sudo=()
+  if [ "$(id -u)" -ne 0 ]; then sudo=(sudo); fi
+  "${sudo[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get install -y -qq --no-install-recommends \
+    "${missing[@]}" >/dev/null
+}
+
+cia_setup_workspace() {
+  mkdir -p "${WS}/src" "${ROS_HOME}"
+  ln -sfn "${REPO_ROOT}" "${WS}/src/camera_imu_alignment"
+}
+
+# cia_build [extra catkin_make targets...]
+cia_build() {
+  cia_setup_workspace
+  (cd "${WS}" && catkin_make -j2 -DCMAKE_BUILD_TYPE=Release \
+      -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 "$@")
+}
+
+# devel/setup.bash reads unset variables (ROS_DISTRO): never source it under set -u.
+cia_source_workspace() {
+  set +u
+  # shellcheck disable=SC1091
+  source "${WS}/devel/setup.bash"
+  set -u
+}

@@ -1,0 +1,152 @@
+#include "camera_imu_alignment/solution_quality.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "camera_imu_alignment/rotation_math.h"
+
+namespace camera_imu_alignment {
+namespace {
+
+/// Sandwich covariance for pairs that share poses. Linearised, r_kt = J_kt delta + e_kt with
+/// e_kt = A_kt w_t - w_k, w_p ~ N(0, s2 I) the (camera-frame) noise of pose p. With g_p the sum of
+/// J^T times the coefficient of w_p over the pairs that use pose p and G = sum_p g_p g_p^T:
+///   Cov(delta) = s2 H^-1 G H^-1,  E[sum |r|^2] = s2 (6 N - tr(H^-1 G)).
+/// For independent pairs (e_j ~ N(0, s2 I)) the same algebra gives G = H and 3N - 3 degrees of freedom.
+struct NoiseModel {
+  Eigen::Matrix3d G = Eigen::Matrix3d::Zero();
+  double noise_dims = 0.0;  // tr(S_e) / s2
+};
+
+bool allPairsHavePoses(const RotationPairs& pairs, const std::vector<int>& used) {
+  for (int j : used) {
+    if (pairs[j].pose_k < 0 || pairs[j].pose_t < 0) return false;
+  }
+  return !used.empty();
+}
+
+}  // namespace
+
+Eigen::Vector3d pairResidual(const RotationPair& pair, const Eigen::Matrix3d& R_cam_imu) {
+  return logSO3(pair.A_cam * R_cam_imu * pair.B_imu.transpose() * R_cam_imu.transpose());
+}
+
+Eigen::Matrix3d pairJacobian(const RotationPair& pair, const Eigen::Vector3d& residual) {
+  return leftJacobianInverse(residual) * pair.A_cam - leftJacobianInverse(-residual);
+}
+
+void pairAnglesDeg(const RotationPair& pair, double* angle_cam_deg, double* angle_imu_deg) {
+  *angle_cam_deg = rad2deg(rotationAngle(pair.A_cam));
+  *angle_imu_deg = rad2deg(rotationAngle(pair.B_imu));
+}
+
+std::string axisName(const Eigen::Vector3d& axis) {
+  Eigen::Index i = 0;
+  axis.cwiseAbs().maxCoeff(&i);
+  return std::string(1, "xyz"[i]);
+}
+
+SolutionQuality evaluateQuality(const RotationPairs& pairs, const Eigen::Matrix3d& R_cam_imu,
+                                const std::vector<bool>& inlier,
+                                const std::vector<std::string>& rejection,
+                                const QualityOptions& options) {
+  SolutionQuality q;
+  q.num_pairs = static_cast<int>(pairs.size());
+  q.pairs.resize(pairs.size());
+  std::vector<int> used;
+  std::vector<Eigen::Vector3d> residuals(pairs.size());
+  std::vector<Eigen::Matrix3d> jacobians(pairs.size());
+  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+  double sum_sq = 0.0;
+  for (size_t j = 0; j < pairs.size(); ++j) {
+    PairDiagnostics& d = q.pairs[j];
+    residuals[j] = pairResidual(pairs[j], R_cam_imu);
+    d.residual_deg = rad2deg(residuals[j].norm());
+    pairAnglesDeg(pairs[j], &d.angle_cam_deg, &d.angle_imu_deg);
+    d.inlier = inlier.empty() || inlier[j];
+    if (!d.inlier && j < rejection.size()) d.rejection = rejection[j];
+    if (!d.inlier) continue;
+    used.push_back(static_cast<int>(j));
+    jacobians[j] = pairJacobian(pairs[j], residuals[j]);
+    H += jacobians[j].transpose() * jacobians[j];
+    sum_sq += residuals[j].squaredNorm();
+  }
+  q.num_inliers = static_cast<int>(used.size());
+  if (used.empty()) {
+    q.observability_message = "not observable: no usable pair";
+    return q;
+  }
+  q.residual_rms_deg = rad2deg(std::sqrt(sum_sq / used.size()));
+
+  // Observability from the spread of rotation axes: the information matrix H is about
+  // sum_j 2 (1 - cos theta_j) (I - a_j a_j^T), blind along a common axis a.
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(0.5 * (H + H.transpose()));
+  const Eigen::Vector3d lambda = eig.eigenvalues().cwiseMax(0.0);  // ascending
+  const double mean_lambda = lambda.sum() / 3.0;
+  q.observability = mean_lambda > 0.0 ? std::min(1.0, lambda(0) / mean_lambda) : 0.0;
+  q.weak_axis_cam = eig.eigenvectors().col(0).normalized();
+  q.excite_axis_cam = eig.eigenvectors().col(2).normalized();
+  // Sign convention for readability: the largest component positive.
+  for (Eigen::Vector3d* axis : {&q.weak_axis_cam, &q.excite_axis_cam}) {
+    Eigen::Index i = 0;
+    axis->cwiseAbs().maxCoeff(&i);
+    if ((*axis)(i) < 0.0) *axis = -*axis;
+  }
+  q.weakest_excitation_deg = rad2deg(std::sqrt(lambda(0) / used.size()));
+
+  // Noise model and covariance.
+  NoiseModel model;
+  if (allPairsHavePoses(pairs, used)) {
+    int num_poses = 0;
+    for (int j : used) num_poses = std::max({num_poses, pairs[j].pose_k + 1, pairs[j].pose_t + 1});
+    std::vector<Eigen::Matrix3d> g(num_poses, Eigen::Matrix3d::Zero());
+    for (int j : used) {
+      g[pairs[j].pose_t] += jacobians[j].transpose() * pairs[j].A_cam;
+      g[pairs[j].pose_k] -= jacobians[j].transpose();
+    }
+    for (const auto& gp : g) model.G += gp * gp.transpose();
+    model.noise_dims = 6.0 * used.size();
+  } else {
+    model.G = H;
+    model.noise_dims = 3.0 * used.size();
+  }
+
+  const double tiny = 1e-12 * std::max(1.0, lambda(2));
+  double residual_var = 0.0;  // per-component noise variance s2 (rad^2)
+  if (lambda(0) > tiny) {
+    const Eigen::Matrix3d H_inv = H.inverse();
+    const double dof = model.noise_dims - (H_inv * model.G).trace();
+    if (dof > 0.5) {
+      residual_var = sum_sq / dof;
+      q.covariance_rad2 = residual_var * H_inv * model.G * H_inv;
+      for (int i = 0; i < 3; ++i) {
+        q.std_dev_deg(i) = std::min(180.0, rad2deg(std::sqrt(std::max(0.0, q.covariance_rad2(i, i)))));
+      }
+    }
+  }
+  const double noise_deg = rad2deg(std::sqrt(residual_var));
+  const double needed_deg = std::max(options.min_excitation_deg,
+                                     options.min_excitation_noise_ratio * noise_deg);
+  std::ostringstream msg;
+  msg.precision(3);
+  if (used.size() < 2 || lambda(0) <= tiny || q.weakest_excitation_deg < needed_deg) {
+    q.observable = false;
+    const std::string weak = axisName(q.weak_axis_cam);
+    const std::string others = weak == "x" ? "y or z" : weak == "y" ? "x or z" : "x or y";
+    msg << "not observable: the rotations were (nearly) all about camera " << weak << " (axis ["
+        << q.weak_axis_cam.transpose() << "]; excitation of the other axes "
+        << q.weakest_excitation_deg << " deg, needs " << needed_deg
+        << " deg), so R_cam_imu is free about it; rotate the rig about the camera " << others
+        << " axis (best: camera " << axisName(q.excite_axis_cam) << ")";
+  } else {
+    q.observable = true;
+    msg << "observable (observability " << q.observability << ", weakest excitation "
+        << q.weakest_excitation_deg << " deg about camera " << axisName(q.weak_axis_cam) << ")";
+  }
+  q.observability_message = msg.str();
+  return q;
+}
+
+}  // namespace camera_imu_alignment
