@@ -1,7 +1,7 @@
 // The paper's two-step iteration: literal equations, convergence, sign fix, trace and limits.
 #include <gtest/gtest.h>
 
-#include <Eigen/SVD>
+#include <Eigen/Dense>
 
 #include "camera_imu_alignment/alignment_solver.h"
 #include "camera_imu_alignment/two_step_solver.h"
@@ -21,24 +21,60 @@ Eigen::Matrix3d polarWithSign(const Eigen::Matrix3d& M) {
   return svd.matrixU() * svd.matrixV().transpose();
 }
 
-TEST(TwoStepSolver, FirstIterationMatchesPowerMethodStep) {
+/// The paper's formulas with explicitly stacked matrices and Eigen's own pseudo-inverse.
+struct StackedSystem {
+  Eigen::MatrixXd H1, H2, pinv_H1, pinv_H2;
+  explicit StackedSystem(const RotationPairs& pairs) {
+    const int J = static_cast<int>(pairs.size());
+    H1.resize(3 * J, 3);
+    H2.resize(3, 3 * J);
+    for (int j = 0; j < J; ++j) {
+      H1.block(3 * j, 0, 3, 3) = pairs[j].A_cam;
+      H2.block(0, 3 * j, 3, 3) = pairs[j].B_imu;
+    }
+    pinv_H1 = H1.completeOrthogonalDecomposition().pseudoInverse();
+    pinv_H2 = H2.completeOrthogonalDecomposition().pseudoInverse();
+  }
+  static Eigen::MatrixXd V2H(const Eigen::MatrixXd& V) {
+    Eigen::MatrixXd H(3, V.rows());
+    for (int j = 0; j < V.rows() / 3; ++j) H.block(0, 3 * j, 3, 3) = V.block(3 * j, 0, 3, 3);
+    return H;
+  }
+  static Eigen::MatrixXd H2V(const Eigen::MatrixXd& H) {
+    Eigen::MatrixXd V(H.cols(), 3);
+    for (int j = 0; j < H.cols() / 3; ++j) V.block(3 * j, 0, 3, 3) = H.block(0, 3 * j, 3, 3);
+    return V;
+  }
+  Eigen::Matrix3d rightStep(const Eigen::Matrix3d& R_left) const { return V2H(H1 * R_left) * pinv_H2; }
+  Eigen::Matrix3d leftStep(const Eigen::Matrix3d& R_right) const { return pinv_H1 * H2V(R_right * H2); }
+};
+
+TEST(TwoStepSolver, IteratesFollowThePapersStackedFormulas) {
   std::mt19937_64 rng(11);
   const Eigen::Matrix3d X = randomRotation(rng);
   RotationPairs pairs = test::paperPairs(rng, X, 20, 0.02);
   TwoStepOptions options;
-  options.max_iterations = 1;
   options.record_trace = true;
   const TwoStepResult r = solveTwoStep(pairs, options);
-  ASSERT_EQ(r.trace.size(), 1u);
+  ASSERT_GE(r.trace.size(), 3u);
+  const StackedSystem sys(pairs);
+  Eigen::Matrix3d R_left = Eigen::Matrix3d::Identity();
+  for (const auto& it : r.trace) {
+    const Eigen::Matrix3d R_right = polarWithSign(sys.rightStep(R_left));
+    EXPECT_LT((it.R_right - R_right).norm(), 1e-10) << "iteration " << it.iteration;
+    R_left = polarWithSign(sys.leftStep(it.R_right));
+    EXPECT_LT((it.R_left - R_left).norm(), 1e-10) << "iteration " << it.iteration;
+    R_left = it.R_left;
+  }
+  // pinv(H2) = H2^T / J: the right step is (1/J) sum A_j R B_j^T (an SVD power method).
   Eigen::Matrix3d M_right = Eigen::Matrix3d::Zero();
-  for (const auto& p : pairs) M_right += p.A_cam * p.B_imu.transpose() / 20.0;  // R^l_0 = I
-  const Eigen::Matrix3d R_right = polarWithSign(M_right);
-  EXPECT_LT((r.trace[0].R_right - R_right).norm(), 1e-12);
-  Eigen::Matrix3d M_left = Eigen::Matrix3d::Zero();
-  for (const auto& p : pairs) M_left += p.A_cam.transpose() * R_right * p.B_imu / 20.0;
-  EXPECT_LT((r.trace[0].R_left - polarWithSign(M_left)).norm(), 1e-12);
-  EXPECT_EQ(r.iterations, 1);
-  EXPECT_FALSE(r.converged);
+  for (const auto& p : pairs) M_right += p.A_cam * p.B_imu.transpose() / 20.0;  // from R^l_0 = I
+  EXPECT_LT((sys.rightStep(Eigen::Matrix3d::Identity()) - M_right).norm(), 1e-12);
+  TwoStepOptions one;
+  one.max_iterations = 1;
+  const TwoStepResult first = solveTwoStep(pairs, one);
+  EXPECT_EQ(first.iterations, 1);
+  EXPECT_FALSE(first.converged);
 }
 
 TEST(TwoStepSolver, NoiseFreeConvergesToTruthForMountingsWithin90DegOfTheStart) {

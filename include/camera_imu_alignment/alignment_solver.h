@@ -24,7 +24,8 @@ bool parseSolverMethod(const std::string& text, SolverMethod* method);
 
 struct SolverOptions {
   SolverMethod method = SolverMethod::kOptimal;
-  OptimalOptions optimal;  ///< optimal.two_step also configures the two-step method
+  OptimalOptions optimal;   ///< the default method (optimal.two_step: its two-step start)
+  TwoStepOptions two_step;  ///< the two-step method run alone
   QualityOptions quality;
 };
 

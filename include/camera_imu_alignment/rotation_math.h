@@ -25,12 +25,16 @@ double rotationAngle(const Eigen::Matrix3d& R);
 /// Geodesic distance |Log(R_a^T R_b)| in rad.
 double geodesicDistance(const Eigen::Matrix3d& R_a, const Eigen::Matrix3d& R_b);
 
-/// Nearest rotation in the Frobenius norm: M = U S V^T -> U diag(1, 1, det(U V^T)) V^T.
+/// Nearest rotation in the Frobenius norm: M = U S V^T -> U diag(1, 1, det(U V^T)) V^T (for
+/// det(M) > 0 simply U V^T, the orthogonal polar factor, computed by Newton's polar iteration).
 Eigen::Matrix3d projectToSO3(const Eigen::Matrix3d& M);
 
 /// Inverse of the left Jacobian of SO(3): Log(Exp(d) Exp(phi)) ~ phi + Jl^-1(phi) d for small d.
 /// The right-Jacobian inverse is leftJacobianInverse(-phi).
 Eigen::Matrix3d leftJacobianInverse(const Eigen::Vector3d& phi);
+
+/// c(theta) in Jl^-1(phi) = I - Phi/2 + c Phi^2 (Phi = skew(phi), theta = |phi|); 1/12 near 0.
+double jacobianInverseCoefficient(double angle);
 
 /// True when R is finite, orthonormal within `tolerance` (Frobenius) and has det +1.
 bool isRotationMatrix(const Eigen::Matrix3d& R, double tolerance = 1e-6);

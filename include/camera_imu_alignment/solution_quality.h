@@ -68,11 +68,13 @@ Eigen::Matrix3d pairJacobian(const RotationPair& pair, const Eigen::Vector3d& re
 void pairAnglesDeg(const RotationPair& pair, double* angle_cam_deg, double* angle_imu_deg);
 
 /// Evaluates residuals, covariance and observability of R_cam_imu on the pairs; `inlier` marks the
-/// pairs used (all when empty); `rejection` gives reasons for the others (may be empty).
+/// pairs used (all when empty); `rejection` gives reasons for the others (may be empty);
+/// `residuals`, when it has one entry per pair, holds r_j at R_cam_imu already (not recomputed).
 SolutionQuality evaluateQuality(const RotationPairs& pairs, const Eigen::Matrix3d& R_cam_imu,
                                 const std::vector<bool>& inlier = {},
                                 const std::vector<std::string>& rejection = {},
-                                const QualityOptions& options = {});
+                                const QualityOptions& options = {},
+                                const std::vector<Eigen::Vector3d>& residuals = {});
 
 /// Name of the camera axis closest to `axis` ("x", "y" or "z").
 std::string axisName(const Eigen::Vector3d& axis);

@@ -1,6 +1,6 @@
 #include "camera_imu_alignment/alignment_solver.h"
 
-#include <sstream>
+#include <cstdio>
 
 #include "camera_imu_alignment/rotation_math.h"
 
@@ -37,13 +37,14 @@ AlignmentResult solveAlignment(const RotationPairs& pairs, const SolverOptions& 
 
   std::vector<bool> inlier;
   std::vector<std::string> rejection;
+  std::vector<Eigen::Vector3d> residuals;
   if (options.method == SolverMethod::kTwoStep) {
-    result.two_step = solveTwoStep(pairs, options.optimal.two_step);
+    result.two_step = solveTwoStep(pairs, options.two_step);
     result.R_cam_imu = result.two_step.R_cam_imu_left;
     result.iterations = result.two_step.iterations;
     result.converged = result.two_step.converged;
     result.start = "identity";
-    if (options.optimal.two_step.initial_R_cam_imu) result.start = "given";
+    if (options.two_step.initial_R_cam_imu) result.start = "given";
   } else {
     const OptimalResult opt = solveOptimal(pairs, options.optimal);
     result.two_step = opt.two_step;
@@ -53,6 +54,7 @@ AlignmentResult solveAlignment(const RotationPairs& pairs, const SolverOptions& 
     result.start = opt.start;
     inlier = opt.inlier;
     rejection = opt.rejection;
+    residuals = opt.residuals;
   }
   if (!result.R_cam_imu.allFinite()) {
     result.R_cam_imu.setIdentity();
@@ -60,19 +62,19 @@ AlignmentResult solveAlignment(const RotationPairs& pairs, const SolverOptions& 
     result.message = "the solver produced no finite estimate";
     return result;
   }
-  result.quality = evaluateQuality(pairs, result.R_cam_imu, inlier, rejection, options.quality);
+  result.quality = evaluateQuality(pairs, result.R_cam_imu, inlier, rejection, options.quality, residuals);
   result.status = result.quality.observable ? SolveStatus::kOk : SolveStatus::kNotObservable;
-  std::ostringstream msg;
-  msg.precision(3);
   if (result.quality.observable) {
-    msg << "solved with " << toString(options.method) << ": " << result.quality.num_inliers << "/"
-        << result.quality.num_pairs << " pairs, residual RMS " << result.quality.residual_rms_deg
-        << " deg, 1-sigma [" << result.quality.std_dev_deg.transpose() << "] deg";
-    if (!result.converged) msg << " (iteration limit reached before convergence)";
+    char msg[256];
+    const Eigen::Vector3d& sd = result.quality.std_dev_deg;
+    std::snprintf(msg, sizeof(msg), "solved with %s: %d/%d pairs, residual RMS %.3g deg, 1-sigma [%.3g %.3g %.3g] deg%s",
+                  toString(options.method).c_str(), result.quality.num_inliers, result.quality.num_pairs,
+                  result.quality.residual_rms_deg, sd.x(), sd.y(), sd.z(),
+                  result.converged ? "" : " (iteration limit reached before convergence)");
+    result.message = msg;
   } else {
-    msg << result.quality.observability_message;
+    result.message = result.quality.observability_message;
   }
-  result.message = msg.str();
   return result;
 }
 

@@ -29,11 +29,25 @@ double robustLoss(double r2, double cauchy_scale) {
   return c2 * std::log1p(r2 / c2);
 }
 
-double totalLoss(const RotationPairs& pairs, const std::vector<int>& idx, const Eigen::Matrix3d& X,
-                 double cauchy_scale) {
+/// Residual vectors r_j at X for the pairs in idx; returns the total loss.
+double evaluateResiduals(const RotationPairs& pairs, const std::vector<int>& idx,
+                         const Eigen::Matrix3d& X, double cauchy_scale,
+                         std::vector<Eigen::Vector3d>* residuals) {
+  residuals->resize(idx.size());
   double cost = 0.0;
-  for (int j : idx) cost += robustLoss(pairResidual(pairs[j], X).squaredNorm(), cauchy_scale);
+  for (size_t i = 0; i < idx.size(); ++i) {
+    (*residuals)[i] = pairResidual(pairs[idx[i]], X);
+    cost += robustLoss((*residuals)[i].squaredNorm(), cauchy_scale);
+  }
   return cost;
+}
+
+std::vector<double> normsOf(const std::vector<Eigen::Vector3d>& residuals, size_t count) {
+  if (residuals.size() != count) return std::vector<double>(count, INFINITY);
+  std::vector<double> norms;
+  norms.reserve(count);
+  for (const auto& r : residuals) norms.push_back(r.norm());
+  return norms;
 }
 
 std::vector<double> residualNorms(const RotationPairs& pairs, const std::vector<int>& idx,
@@ -69,54 +83,60 @@ bool goodSample(const RotationPair& p) {
 }  // namespace
 
 int refineRotation(const RotationPairs& pairs, const std::vector<int>& indices,
-                   double cauchy_scale_rad, int max_iterations, double step_tolerance_rad,
-                   Eigen::Matrix3d* R_cam_imu, bool* converged) {
+                   const RefineSettings& settings, Eigen::Matrix3d* R_cam_imu, bool* converged,
+                   std::vector<Eigen::Vector3d>* residuals_io) {
   *converged = false;
   Eigen::Matrix3d X = *R_cam_imu;
+  const double scale = settings.cauchy_scale_rad;
   double lambda = 0.0;  // Levenberg-Marquardt damping, used only after a failed Gauss-Newton step
-  double cost = totalLoss(pairs, indices, X, cauchy_scale_rad);
+  std::vector<Eigen::Vector3d> own_residuals, trial_residuals;
+  std::vector<Eigen::Vector3d>& residuals = residuals_io ? *residuals_io : own_residuals;
+  double cost = 0.0;
+  if (residuals.size() == indices.size()) {
+    for (const auto& r : residuals) cost += robustLoss(r.squaredNorm(), scale);
+  } else {
+    cost = evaluateResiduals(pairs, indices, X, scale, &residuals);
+  }
+  const double c2 = scale * scale;
+  const double dof = std::max(1.0, 3.0 * indices.size() - 3.0);
   int it = 0;
-  for (; it < max_iterations; ++it) {
+  while (it < settings.max_iterations && !*converged) {
+    ++it;
     Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
     Eigen::Vector3d g = Eigen::Vector3d::Zero();
-    for (int j : indices) {
-      const Eigen::Vector3d r = pairResidual(pairs[j], X);
-      const Eigen::Matrix3d Jac = pairJacobian(pairs[j], r);
-      double w = 1.0;
-      if (cauchy_scale_rad > 0.0) w = 1.0 / (1.0 + r.squaredNorm() / (cauchy_scale_rad * cauchy_scale_rad));
+    for (size_t i = 0; i < indices.size(); ++i) {
+      const Eigen::Vector3d& r = residuals[i];
+      const Eigen::Matrix3d Jac = pairJacobian(pairs[indices[i]], r);
+      const double w = scale > 0.0 ? 1.0 / (1.0 + r.squaredNorm() / c2) : 1.0;
       H.noalias() += w * Jac.transpose() * Jac;
       g.noalias() += w * Jac.transpose() * r;
     }
+    // Tolerance on the step: absolute, or relative to the 1-sigma sqrt(s2 tr(H^-1)) (squared loss).
+    double tolerance = settings.step_tolerance_rad;
+    if (scale <= 0.0) {
+      const double sigma = std::sqrt(cost / dof * H.inverse().trace());
+      if (std::isfinite(sigma)) tolerance = std::max(tolerance, settings.relative_step_tolerance * sigma);
+    }
     bool accepted = false;
     for (int attempt = 0; attempt < 20 && !accepted; ++attempt) {
-      const Eigen::Matrix3d H_damped = H + lambda * Eigen::Matrix3d::Identity();
-      const Eigen::Vector3d delta = -H_damped.ldlt().solve(g);
+      const Eigen::Vector3d delta = -(H + lambda * Eigen::Matrix3d::Identity()).ldlt().solve(g);
       if (!delta.allFinite()) break;
       const Eigen::Matrix3d X_new = expSO3(delta) * X;
-      const double new_cost = totalLoss(pairs, indices, X_new, cauchy_scale_rad);
-      if (new_cost <= cost || delta.norm() < step_tolerance_rad) {
+      const double new_cost = evaluateResiduals(pairs, indices, X_new, scale, &trial_residuals);
+      const bool small_step = delta.norm() < tolerance;
+      if (new_cost <= cost || small_step) {
         accepted = true;
         X = X_new;
         cost = new_cost;
-        lambda *= 0.1;
-        if (lambda < 1e-12) lambda = 0.0;
-        if (delta.norm() < step_tolerance_rad) {
-          *converged = true;
-        }
+        residuals.swap(trial_residuals);
+        lambda = lambda < 1e-12 ? 0.0 : 0.1 * lambda;
+        *converged = small_step;
       } else {
         lambda = lambda == 0.0 ? 1e-4 * std::max(1e-9, H.trace() / 3.0) : 10.0 * lambda;
       }
     }
-    if (!accepted) {
-      // No decreasing step exists at machine precision: X is a (local) minimum.
-      *converged = true;
-      ++it;
-      break;
-    }
-    if (*converged) {
-      ++it;
-      break;
-    }
+    // No decreasing step at machine precision: X is a (local) minimum.
+    if (!accepted) *converged = true;
   }
   *R_cam_imu = X;
   return it;
@@ -125,30 +145,32 @@ int refineRotation(const RotationPairs& pairs, const std::vector<int>& indices,
 OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) {
   OptimalResult result;
   const int n = static_cast<int>(pairs.size());
+  const auto settings = [&o](double cauchy_scale) {
+    RefineSettings s;
+    s.cauchy_scale_rad = cauchy_scale;
+    s.max_iterations = o.max_iterations;
+    s.step_tolerance_rad = o.step_tolerance_rad;
+    return s;
+  };
   result.inlier.assign(n, true);
   result.rejection.assign(n, "");
   if (n == 0) return result;
 
   // 1. Angle gate.
+  std::vector<double> angle_diff(n);
+  for (int j = 0; j < n; ++j) {
+    angle_diff[j] = std::abs(rotationAngle(pairs[j].A_cam) - rotationAngle(pairs[j].B_imu));
+  }
   std::vector<int> gated;
-  if (o.reject_outliers) {
-    std::vector<double> diff(n);
-    for (int j = 0; j < n; ++j) {
-      diff[j] = std::abs(rotationAngle(pairs[j].A_cam) - rotationAngle(pairs[j].B_imu));
+  const double gate = std::max(deg2rad(o.angle_gate_min_deg), o.angle_gate_sigmas * 1.4826 * median(angle_diff));
+  for (int j = 0; j < n; ++j) {
+    if (!o.reject_outliers || angle_diff[j] <= gate) {
+      gated.push_back(j);
+      continue;
     }
-    const double gate = std::max(deg2rad(o.angle_gate_min_deg), o.angle_gate_sigmas * 1.4826 * median(diff));
-    for (int j = 0; j < n; ++j) {
-      if (diff[j] > gate) {
-        result.inlier[j] = false;
-        result.rejection[j] = "camera and IMU rotation angles differ by " +
-                              std::to_string(rad2deg(diff[j])) + " deg (gate " +
-                              std::to_string(rad2deg(gate)) + " deg)";
-      } else {
-        gated.push_back(j);
-      }
-    }
-  } else {
-    for (int j = 0; j < n; ++j) gated.push_back(j);
+    result.inlier[j] = false;
+    result.rejection[j] = "camera and IMU rotation angles differ by " + std::to_string(rad2deg(angle_diff[j])) +
+                          " deg (gate " + std::to_string(rad2deg(gate)) + " deg)";
   }
   if (gated.empty()) return result;
 
@@ -159,26 +181,30 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
   result.two_step = solveTwoStep(gated_pairs, o.two_step);
   Eigen::Matrix3d X = result.two_step.R_cam_imu_left;
   result.start = "two_step";
-  double start_median = result.two_step.valid ? median(residualNorms(pairs, gated, X)) : INFINITY;
-  // A converged two-step lands within a fraction of the noise of the optimum; if its residuals are
-  // large compared with the angle mismatch of the data (a noise proxy) or it did not converge, try the
-  // closed form too and keep the better start.
-  std::vector<double> angle_diff;
-  for (int j : gated) angle_diff.push_back(std::abs(rotationAngle(pairs[j].A_cam) - rotationAngle(pairs[j].B_imu)));
-  const double noise_proxy = median(angle_diff);
+  std::vector<Eigen::Vector3d> start_residuals;
+  if (result.two_step.valid) evaluateResiduals(pairs, gated, X, 0.0, &start_residuals);
+  std::vector<double> start_norms = normsOf(start_residuals, gated.size());
+  const double start_median = median(start_norms);
+  std::vector<double> gated_angle_diff;
+  for (int j : gated) gated_angle_diff.push_back(angle_diff[j]);
+  const double noise_proxy = median(gated_angle_diff);
   if (!result.two_step.converged || gated.size() <= 4 ||
-      result.two_step.left_right_disagreement_rad > 1e-3 ||
+      result.two_step.left_right_disagreement_rad > deg2rad(2.0) ||
       start_median > 4.0 * noise_proxy + 1e-9) {
     if (auto cf = solveClosedForm(pairs, gated)) {
-      const double cf_median = median(residualNorms(pairs, gated, *cf));
-      if (cf_median < start_median) {
+      std::vector<Eigen::Vector3d> cf_residuals;
+      evaluateResiduals(pairs, gated, *cf, 0.0, &cf_residuals);
+      std::vector<double> cf_norms = normsOf(cf_residuals, gated.size());
+      if (median(cf_norms) < start_median) {
         X = *cf;
-        start_median = cf_median;
+        start_norms.swap(cf_norms);
+        start_residuals.swap(cf_residuals);
         result.start = "closed_form";
       }
     }
   }
   if (!X.allFinite()) return result;
+  const Eigen::Matrix3d X_start = X;
 
   // 3. Consensus.
   std::vector<int> inliers = gated;
@@ -190,13 +216,16 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
       }
       return in;
     };
-    double threshold = inlierThreshold(residualNorms(pairs, gated, X), o);
-    inliers = classify(X, threshold);
+    double threshold = inlierThreshold(start_norms, o);
+    inliers.clear();
+    for (size_t i = 0; i < gated.size(); ++i) {
+      if (start_norms[i] <= threshold) inliers.push_back(gated[i]);
+    }
     if (inliers.size() < gated.size()) {
       // Suspected outliers: robust refit from the start, then RANSAC for a larger consensus.
       bool conv = false;
       const double scale = std::max(deg2rad(o.inlier_min_deg), threshold / o.inlier_sigmas);
-      result.iterations += refineRotation(pairs, gated, scale, o.max_iterations, o.step_tolerance_rad, &X, &conv);
+      result.iterations += refineRotation(pairs, gated, settings(scale), &X, &conv);
       threshold = inlierThreshold(residualNorms(pairs, gated, X), o);
       inliers = classify(X, threshold);
       std::vector<int> samples;
@@ -215,7 +244,7 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
           std::vector<int> in_h = classify(X_h, threshold);
           if (in_h.size() > inliers.size()) {
             bool c = false;
-            result.iterations += refineRotation(pairs, in_h, 0.0, o.max_iterations, o.step_tolerance_rad, &X_h, &c);
+            result.iterations += refineRotation(pairs, in_h, settings(0.0), &X_h, &c);
             std::vector<int> in_refined = classify(X_h, threshold);
             if (in_refined.size() > inliers.size()) {
               inliers = std::move(in_refined);
@@ -228,20 +257,28 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
     if (inliers.size() < 2) inliers = gated;  // never fit fewer pairs than the minimum
   }
 
-  // 4. Final least squares on the inliers.
+  // 4. Final least squares on the inliers (reusing the start residuals when nothing changed).
+  std::vector<Eigen::Vector3d> final_residuals;
+  if (inliers == gated && X == X_start) final_residuals = start_residuals;
   bool converged = false;
-  result.iterations += refineRotation(pairs, inliers, 0.0, o.max_iterations, o.step_tolerance_rad, &X, &converged);
+  result.iterations += refineRotation(pairs, inliers, settings(0.0), &X, &converged, &final_residuals);
   result.converged = converged;
   result.R_cam_imu = X;
   result.valid = X.allFinite();
+  result.residuals.assign(n, Eigen::Vector3d::Zero());
+  for (size_t i = 0; i < inliers.size(); ++i) result.residuals[inliers[i]] = final_residuals[i];
 
   std::vector<bool> is_inlier(n, false);
   for (int j : inliers) is_inlier[j] = true;
+  for (int j = 0; j < n; ++j) {
+    if (!result.inlier[j]) result.residuals[j] = pairResidual(pairs[j], X);
+  }
   for (int j : gated) {
     if (!is_inlier[j]) {
       result.inlier[j] = false;
+      result.residuals[j] = pairResidual(pairs[j], X);
       result.rejection[j] = "inconsistent with the consensus: residual " +
-                            std::to_string(rad2deg(pairResidual(pairs[j], X).norm())) + " deg";
+                            std::to_string(rad2deg(result.residuals[j].norm())) + " deg";
     }
   }
   return result;

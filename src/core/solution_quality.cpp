@@ -3,7 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <sstream>
+#include <cstdio>
 
 #include "camera_imu_alignment/rotation_math.h"
 
@@ -34,7 +34,11 @@ Eigen::Vector3d pairResidual(const RotationPair& pair, const Eigen::Matrix3d& R_
 }
 
 Eigen::Matrix3d pairJacobian(const RotationPair& pair, const Eigen::Vector3d& residual) {
-  return leftJacobianInverse(residual) * pair.A_cam - leftJacobianInverse(-residual);
+  // Jl^-1(r) = I - Phi/2 + c Phi^2 and Jr^-1(r) = Jl^-1(-r) = I + Phi/2 + c Phi^2 share Phi^2.
+  const Eigen::Matrix3d Phi = skew(residual);
+  const Eigen::Matrix3d common =
+      Eigen::Matrix3d::Identity() + jacobianInverseCoefficient(residual.norm()) * Phi * Phi;
+  return (common - 0.5 * Phi) * pair.A_cam - (common + 0.5 * Phi);
 }
 
 void pairAnglesDeg(const RotationPair& pair, double* angle_cam_deg, double* angle_imu_deg) {
@@ -51,7 +55,8 @@ std::string axisName(const Eigen::Vector3d& axis) {
 SolutionQuality evaluateQuality(const RotationPairs& pairs, const Eigen::Matrix3d& R_cam_imu,
                                 const std::vector<bool>& inlier,
                                 const std::vector<std::string>& rejection,
-                                const QualityOptions& options) {
+                                const QualityOptions& options,
+                                const std::vector<Eigen::Vector3d>& given_residuals) {
   SolutionQuality q;
   q.num_pairs = static_cast<int>(pairs.size());
   q.pairs.resize(pairs.size());
@@ -62,7 +67,7 @@ SolutionQuality evaluateQuality(const RotationPairs& pairs, const Eigen::Matrix3
   double sum_sq = 0.0;
   for (size_t j = 0; j < pairs.size(); ++j) {
     PairDiagnostics& d = q.pairs[j];
-    residuals[j] = pairResidual(pairs[j], R_cam_imu);
+    residuals[j] = given_residuals.size() == pairs.size() ? given_residuals[j] : pairResidual(pairs[j], R_cam_imu);
     d.residual_deg = rad2deg(residuals[j].norm());
     pairAnglesDeg(pairs[j], &d.angle_cam_deg, &d.angle_imu_deg);
     d.inlier = inlier.empty() || inlier[j];
@@ -129,23 +134,23 @@ SolutionQuality evaluateQuality(const RotationPairs& pairs, const Eigen::Matrix3
   const double noise_deg = rad2deg(std::sqrt(residual_var));
   const double needed_deg = std::max(options.min_excitation_deg,
                                      options.min_excitation_noise_ratio * noise_deg);
-  std::ostringstream msg;
-  msg.precision(3);
+  char msg[512];
   if (used.size() < 2 || lambda(0) <= tiny || q.weakest_excitation_deg < needed_deg) {
     q.observable = false;
     const std::string weak = axisName(q.weak_axis_cam);
-    const std::string others = weak == "x" ? "y or z" : weak == "y" ? "x or z" : "x or y";
-    msg << "not observable: the rotations were (nearly) all about camera " << weak << " (axis ["
-        << q.weak_axis_cam.transpose() << "]; excitation of the other axes "
-        << q.weakest_excitation_deg << " deg, needs " << needed_deg
-        << " deg), so R_cam_imu is free about it; rotate the rig about the camera " << others
-        << " axis (best: camera " << axisName(q.excite_axis_cam) << ")";
+    const char* others = weak == "x" ? "y or z" : weak == "y" ? "x or z" : "x or y";
+    std::snprintf(msg, sizeof(msg),
+                  "not observable: the rotations were (nearly) all about camera %s (axis [%.3f %.3f "
+                  "%.3f]; excitation of the other axes %.3g deg, needs %.3g deg), so R_cam_imu is "
+                  "free about it; rotate the rig about the camera %s axis (best: camera %s)",
+                  weak.c_str(), q.weak_axis_cam.x(), q.weak_axis_cam.y(), q.weak_axis_cam.z(),
+                  q.weakest_excitation_deg, needed_deg, others, axisName(q.excite_axis_cam).c_str());
   } else {
     q.observable = true;
-    msg << "observable (observability " << q.observability << ", weakest excitation "
-        << q.weakest_excitation_deg << " deg about camera " << axisName(q.weak_axis_cam) << ")";
+    std::snprintf(msg, sizeof(msg), "observable (observability %.3g, weakest excitation %.3g deg about camera %s)",
+                  q.observability, q.weakest_excitation_deg, axisName(q.weak_axis_cam).c_str());
   }
-  q.observability_message = msg.str();
+  q.observability_message = msg;
   return q;
 }
 

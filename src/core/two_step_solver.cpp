@@ -5,33 +5,19 @@
 //   left step          R^l_n = pinv(H1) H2V(R^r_n H2)
 //   SVD projection     M = U S V^T -> U V^T, after negating M when det(M) < 0 (sign fix)
 //   stopping rule      successive iterates closer than a tolerance
+// H1, H2 and the pseudo-inverses are kept as their 3x3 blocks and each step is applied as the 9x9
+// linear map it is (built once per solve); test_two_step_solver checks the iterates against the
+// formulas evaluated with explicitly stacked H1, H2 and Eigen's own pseudo-inverses.
 #include "camera_imu_alignment/two_step_solver.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
 
 #include "camera_imu_alignment/rotation_math.h"
 
 namespace camera_imu_alignment {
 namespace {
-
-using MatrixX3 = Eigen::Matrix<double, Eigen::Dynamic, 3>;
-using Matrix3X = Eigen::Matrix<double, 3, Eigen::Dynamic>;
-
-/// V2H: [M_1; ...; M_J] (3J x 3) -> [M_1 ... M_J] (3 x 3J).
-Matrix3X verticalToHorizontal(const MatrixX3& V) {
-  const Eigen::Index J = V.rows() / 3;
-  Matrix3X H(3, 3 * J);
-  for (Eigen::Index j = 0; j < J; ++j) H.middleCols<3>(3 * j) = V.middleRows<3>(3 * j);
-  return H;
-}
-
-/// H2V: [M_1 ... M_J] (3 x 3J) -> [M_1; ...; M_J] (3J x 3).
-MatrixX3 horizontalToVertical(const Matrix3X& H) {
-  const Eigen::Index J = H.cols() / 3;
-  MatrixX3 V(3 * J, 3);
-  for (Eigen::Index j = 0; j < J; ++j) V.middleRows<3>(3 * j) = H.middleCols<3>(3 * j);
-  return V;
-}
 
 /// The paper's projection with the determinant sign fix: negate M when det(M) < 0, then U V^T.
 Eigen::Matrix3d projectWithSignFix(const Eigen::Matrix3d& M, bool* sign_fixed) {
@@ -39,25 +25,50 @@ Eigen::Matrix3d projectWithSignFix(const Eigen::Matrix3d& M, bool* sign_fixed) {
   return projectToSO3(*sign_fixed ? Eigen::Matrix3d(-M) : M);
 }
 
+/// Geodesic angle between two rotations from their Frobenius distance, |R1 - R2|_F = 2 sqrt(2)
+/// sin(theta / 2): exact, and cheaper than a logarithm in the convergence test.
+double stepAngle(const Eigen::Matrix3d& R1, const Eigen::Matrix3d& R2) {
+  const double s = std::min(1.0, (R1 - R2).norm() / (2.0 * std::sqrt(2.0)));
+  return 2.0 * std::asin(s);
+}
+
 }  // namespace
 
 TwoStepResult solveTwoStep(const RotationPairs& pairs, const TwoStepOptions& options) {
   TwoStepResult result;
-  const Eigen::Index J = static_cast<Eigen::Index>(pairs.size());
+  const size_t J = pairs.size();
   if (J < 1) return result;
 
-  MatrixX3 H1(3 * J, 3);
-  Matrix3X H2(3, 3 * J);
-  for (Eigen::Index j = 0; j < J; ++j) {
-    H1.middleRows<3>(3 * j) = pairs[j].A_cam;
-    H2.middleCols<3>(3 * j) = pairs[j].B_imu;
+  // H1 = [A_1; ...; A_J] (3J x 3) and H2 = [B_1 ... B_J] (3 x 3J), kept as their 3x3 blocks.
+  // Moore-Penrose pseudo-inverses: H1 has full column rank and H2 full row rank (they stack
+  // rotations, H1^T H1 = H2 H2^T = J I up to rounding), so
+  //   pinv(H1) = (H1^T H1)^-1 H1^T = [P1_1 ... P1_J],  P1_j = (H1^T H1)^-1 A_j^T
+  //   pinv(H2) = H2^T (H2 H2^T)^-1 = [P2_1; ...; P2_J], P2_j = B_j^T (H2 H2^T)^-1
+  Eigen::Matrix3d H1tH1 = Eigen::Matrix3d::Zero(), H2H2t = Eigen::Matrix3d::Zero();
+  for (const auto& p : pairs) {
+    H1tH1.noalias() += p.A_cam.transpose() * p.A_cam;
+    H2H2t.noalias() += p.B_imu * p.B_imu.transpose();
   }
-  if (!H1.allFinite() || !H2.allFinite()) return result;
-
-  // Moore-Penrose pseudo-inverses. H1 has full column rank and H2 full row rank (they stack
-  // rotations: H1^T H1 = H2 H2^T = J I), so pinv(H1) = (H1^T H1)^-1 H1^T, pinv(H2) = H2^T (H2 H2^T)^-1.
-  const Eigen::Matrix<double, 3, Eigen::Dynamic> pinv_H1 = (H1.transpose() * H1).inverse() * H1.transpose();
-  const Eigen::Matrix<double, Eigen::Dynamic, 3> pinv_H2 = H2.transpose() * (H2 * H2.transpose()).inverse();
+  if (!H1tH1.allFinite() || !H2H2t.allFinite()) return result;
+  const Eigen::Matrix3d H1tH1_inv = H1tH1.inverse(), H2H2t_inv = H2H2t.inverse();
+  // Both steps are linear in R before the projection. With column-major vec and
+  // vec(L R M) = (M^T (x) L) vec(R):
+  //   right: vec(V2H(H1 R) pinv(H2)) = vec(sum_j A_j R P2_j) = K_right vec(R), K_right = sum_j P2_j^T (x) A_j
+  //   left:  vec(pinv(H1) H2V(R H2)) = vec(sum_j P1_j R B_j) = K_left vec(R),  K_left = sum_j B_j^T (x) P1_j
+  // The 9x9 operators are built once from the blocks of H1, H2 and their pseudo-inverses, so each
+  // iteration costs two 9x9 products instead of 4J 3x3 products (same numbers, J-independent).
+  using Matrix9 = Eigen::Matrix<double, 9, 9>;
+  Matrix9 K_right = Matrix9::Zero(), K_left = Matrix9::Zero();
+  for (size_t j = 0; j < J; ++j) {
+    const Eigen::Matrix3d P1_j = H1tH1_inv * pairs[j].A_cam.transpose();  // block j of pinv(H1)
+    const Eigen::Matrix3d P2_j = pairs[j].B_imu.transpose() * H2H2t_inv;  // block j of pinv(H2)
+    for (int c = 0; c < 3; ++c) {
+      for (int r = 0; r < 3; ++r) {
+        K_right.block<3, 3>(3 * r, 3 * c) += P2_j(c, r) * pairs[j].A_cam;  // (P2_j^T)(r, c) = P2_j(c, r)
+        K_left.block<3, 3>(3 * r, 3 * c) += pairs[j].B_imu(c, r) * P1_j;
+      }
+    }
+  }
 
   Eigen::Matrix3d R_left = options.initial_R_cam_imu.value_or(Eigen::Matrix3d::Identity());
   Eigen::Matrix3d R_right = R_left;
@@ -65,14 +76,18 @@ TwoStepResult solveTwoStep(const RotationPairs& pairs, const TwoStepOptions& opt
     TwoStepIterate it;
     it.iteration = n;
     // Right step: R^r_n = V2H(H1 R^l_{n-1}) pinv(H2), projected onto SO(3).
-    const Eigen::Matrix3d M_right = verticalToHorizontal(H1 * R_left) * pinv_H2;
+    Eigen::Matrix3d M_right;
+    Eigen::Map<Eigen::Matrix<double, 9, 1>>(M_right.data()) =
+        K_right * Eigen::Map<const Eigen::Matrix<double, 9, 1>>(R_left.data());
     it.R_right = projectWithSignFix(M_right, &it.right_sign_fixed);
     // Left step: R^l_n = pinv(H1) H2V(R^r_n H2), projected onto SO(3).
-    const Eigen::Matrix3d M_left = pinv_H1 * horizontalToVertical(it.R_right * H2);
+    Eigen::Matrix3d M_left;
+    Eigen::Map<Eigen::Matrix<double, 9, 1>>(M_left.data()) =
+        K_left * Eigen::Map<const Eigen::Matrix<double, 9, 1>>(it.R_right.data());
     it.R_left = projectWithSignFix(M_left, &it.left_sign_fixed);
 
-    it.right_step_rad = n == 1 ? kPi : geodesicDistance(R_right, it.R_right);
-    it.left_step_rad = geodesicDistance(R_left, it.R_left);
+    it.right_step_rad = n == 1 ? kPi : stepAngle(R_right, it.R_right);
+    it.left_step_rad = stepAngle(R_left, it.R_left);
     R_right = it.R_right;
     R_left = it.R_left;
     result.iterations = n;

@@ -76,7 +76,7 @@ int run(int argc, char** argv) {
   if (args.has("--max-iterations")) {
     const int n = static_cast<int>(args.getInt("--max-iterations", 100, 1, 1000000));
     options.optimal.max_iterations = n;
-    if (options.method == cia::SolverMethod::kTwoStep) options.optimal.two_step.max_iterations = n;
+    options.two_step.max_iterations = n;
   }
   const long max_poses = args.getInt("--max-poses", 100, 2, 2000);
   std::optional<cia::StoredCalibration> truth;
