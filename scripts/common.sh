@@ -45,8 +45,8 @@ cia_setup_workspace() {
 # cia_build [extra catkin_make targets...]
 cia_build() {
   cia_setup_workspace
-  (cd "${WS}" && catkin_make -j2 -DCMAKE_BUILD_TYPE=Release \
-      -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 "$@")
+  (cd "${WS}" && catkin_make -j2 -DCMAKE_BUILD_TYPE=Release -DCATKIN_ENABLE_TESTING=ON \
+      -DPYTHON_EXECUTABLE=/usr/bin/python3 "$@")
 }
 
 # devel/setup.bash reads unset variables (ROS_DISTRO): never source it under set -u.

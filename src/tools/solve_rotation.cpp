@@ -34,8 +34,9 @@ const char* kUsage =
     "  --output FILE.yaml   write the result YAML there (default: standard output)\n"
     "  --truth TRUTH.yaml   a YAML with R_cam_imu to compare with (prints the error)\n"
     "  --max-poses N        use at most the last N poses (default 100)\n"
-    "exit codes: 0 success, 2 bad input or usage, 3 not observable (the message names the axis\n"
-    "to rotate about)\n";
+    "exit codes: 0 success, 2 bad input or usage, 3 not enough information: not observable (the\n"
+    "message names the axis to rotate about), or the two-step settled on a rotation that does not\n"
+    "fit the data\n";
 
 void printSummary(const cia::AlignmentResult& r) {
   const Eigen::Matrix3d& R = r.R_cam_imu;
@@ -122,7 +123,7 @@ int run(int argc, char** argv) {
     std::cerr << "  error to the truth in " << args.get("--truth") << ": " << err
               << " deg (paper's two-step alone: " << err_two_step << " deg)\n";
   }
-  if (result.status == cia::SolveStatus::kNotObservable) {
+  if (result.status == cia::SolveStatus::kNotObservable || result.status == cia::SolveStatus::kPoorFit) {
     std::cerr << result.message << "\n";
     return kExitNotObservable;
   }
