@@ -26,24 +26,28 @@ void expectPairsError(const std::string& path, const std::vector<std::string>& p
     ADD_FAILURE() << "no error for " << path;
   } catch (const InputError& e) {
     const std::string msg = e.what();
-    for (const auto& part : parts) EXPECT_NE(msg.find(part), std::string::npos) << msg << " lacks " << part;
+    for (const auto& part : parts)
+      EXPECT_NE(msg.find(part), std::string::npos) << msg << " lacks " << part;
   }
 }
 
 const char* kHeader = "qa_w,qa_x,qa_y,qa_z,qb_w,qb_x,qb_y,qb_z\n";
 
 TEST(CsvIo, ReadsColumnsByNameInAnyOrder) {
-  const std::string path = writeTemp(
-      "order.csv",
-      "# a comment\n\nnote,qb_x,qb_y,qb_z,qb_w,qa_w,qa_x,qa_y,qa_z\r\n"
-      "first,0,0,0.70710678,0.70710678,1,0,0,0\r\n"
-      "second,0,0,0,-1,0,1,0,0\r\n");
+  const std::string path =
+      writeTemp("order.csv",
+                "# a comment\n\nnote,qb_x,qb_y,qb_z,qb_w,qa_w,qa_x,qa_y,qa_z\r\n"
+                "first,0,0,0.70710678,0.70710678,1,0,0,0\r\n"
+                "second,0,0,0,-1,0,1,0,0\r\n");
   const RotationPairs pairs = readPairsCsv(path);
   ASSERT_EQ(pairs.size(), 2u);
   EXPECT_LT((pairs[0].A_cam - Eigen::Matrix3d::Identity()).norm(), 1e-12);
-  EXPECT_LT((pairs[0].B_imu - test::axisAngle(Eigen::Vector3d::UnitZ(), test::kPiTest / 2)).norm(), 1e-7);
-  EXPECT_LT((pairs[1].B_imu - Eigen::Matrix3d::Identity()).norm(), 1e-12);  // q = -1 is the identity
-  EXPECT_LT((pairs[1].A_cam - test::axisAngle(Eigen::Vector3d::UnitX(), test::kPiTest)).norm(), 1e-12);
+  EXPECT_LT((pairs[0].B_imu - test::axisAngle(Eigen::Vector3d::UnitZ(), test::kPiTest / 2)).norm(),
+            1e-7);
+  EXPECT_LT((pairs[1].B_imu - Eigen::Matrix3d::Identity()).norm(),
+            1e-12);  // q = -1 is the identity
+  EXPECT_LT((pairs[1].A_cam - test::axisAngle(Eigen::Vector3d::UnitX(), test::kPiTest)).norm(),
+            1e-12);
   EXPECT_EQ(pairs[0].pose_k, -1);
 }
 
@@ -61,15 +65,22 @@ TEST(CsvIo, BadInputNamesFileAndLine) {
   expectPairsError("/nonexistent/pairs.csv", {"/nonexistent/pairs.csv", "cannot open"});
   expectPairsError(writeTemp("empty.csv", ""), {"empty.csv", "empty"});
   expectPairsError(writeTemp("header_only.csv", kHeader), {"header_only.csv", "no data rows"});
-  expectPairsError(writeTemp("bad_header.csv", "qa_w,qa_x,qa_y,qb_w,qb_x,qb_y,qb_z\n1,0,0,1,0,0,0\n"),
-                   {"bad_header.csv:1", "qa_z"});
-  expectPairsError(writeTemp("text.csv", std::string(kHeader) + "1,0,0,0,1,0,0,0\n1,0,zero,0,1,0,0,0\n"),
-                   {"text.csv:3", "qa_y", "not a number"});
-  expectPairsError(writeTemp("nan.csv", std::string(kHeader) + "1,0,0,0,nan,0,0,0\n"), {"nan.csv:2", "not finite"});
-  expectPairsError(writeTemp("inf.csv", std::string(kHeader) + "1,0,0,0,1,inf,0,0\n"), {"inf.csv:2", "not finite"});
-  expectPairsError(writeTemp("short.csv", std::string(kHeader) + "1,0,0,0,1,0\n"), {"short.csv:2", "missing value"});
-  expectPairsError(writeTemp("big.csv", std::string(kHeader) + "1.5,0,0,0,1,0,0,0\n"), {"big.csv:2", "norm"});
-  expectPairsError(writeTemp("zero.csv", std::string(kHeader) + "1,0,0,0,0,0,0,0\n"), {"zero.csv:2", "norm"});
+  expectPairsError(
+      writeTemp("bad_header.csv", "qa_w,qa_x,qa_y,qb_w,qb_x,qb_y,qb_z\n1,0,0,1,0,0,0\n"),
+      {"bad_header.csv:1", "qa_z"});
+  expectPairsError(
+      writeTemp("text.csv", std::string(kHeader) + "1,0,0,0,1,0,0,0\n1,0,zero,0,1,0,0,0\n"),
+      {"text.csv:3", "qa_y", "not a number"});
+  expectPairsError(writeTemp("nan.csv", std::string(kHeader) + "1,0,0,0,nan,0,0,0\n"),
+                   {"nan.csv:2", "not finite"});
+  expectPairsError(writeTemp("inf.csv", std::string(kHeader) + "1,0,0,0,1,inf,0,0\n"),
+                   {"inf.csv:2", "not finite"});
+  expectPairsError(writeTemp("short.csv", std::string(kHeader) + "1,0,0,0,1,0\n"),
+                   {"short.csv:2", "missing value"});
+  expectPairsError(writeTemp("big.csv", std::string(kHeader) + "1.5,0,0,0,1,0,0,0\n"),
+                   {"big.csv:2", "norm"});
+  expectPairsError(writeTemp("zero.csv", std::string(kHeader) + "1,0,0,0,0,0,0,0\n"),
+                   {"zero.csv:2", "norm"});
 }
 
 TEST(CsvIo, PairsAndPosesRoundTrip) {
@@ -161,7 +172,8 @@ TEST(ResultYaml, WritesAtomicallyAndReadsBack) {
   const StoredCalibration back = readResultYaml(path);
   EXPECT_LT(test::angleBetweenDeg(back.R_cam_imu, X), 1e-9);
   EXPECT_EQ(back.camera_frame, "camera_optical_frame");
-  EXPECT_THROW(writeResultYaml("/nonexistent_dir/result.yaml", solvedExample(X), ResultMetadata{}), InputError);
+  EXPECT_THROW(writeResultYaml("/nonexistent_dir/result.yaml", solvedExample(X), ResultMetadata{}),
+               InputError);
   // A failed write leaves no temporary file and the previous file intact.
   EXPECT_FALSE(std::ifstream(path + ".tmp").good());
   EXPECT_LT(test::angleBetweenDeg(readResultYaml(path).R_cam_imu, X), 1e-9);
@@ -179,8 +191,10 @@ TEST(ResultYaml, ReaderErrorsNameTheFile) {
   expectError("/nonexistent/result.yaml", "/nonexistent/result.yaml");
   expectError(writeTemp("invalid.yaml", "R_cam_imu: [unclosed\n"), "invalid.yaml");
   expectError(writeTemp("nokey.yaml", "camera_frame: c\n"), "no R_cam_imu");
-  expectError(writeTemp("badq.yaml", "R_cam_imu:\n  quaternion_xyzw: [0, 0, 0, 2]\n"), "unit quaternion");
-  expectError(writeTemp("badm.yaml", "R_cam_imu:\n  matrix: [[1, 0, 0], [0, 1, 0], [0, 0, 2]]\n"), "rotation");
+  expectError(writeTemp("badq.yaml", "R_cam_imu:\n  quaternion_xyzw: [0, 0, 0, 2]\n"),
+              "unit quaternion");
+  expectError(writeTemp("badm.yaml", "R_cam_imu:\n  matrix: [[1, 0, 0], [0, 1, 0], [0, 0, 2]]\n"),
+              "rotation");
 }
 
 }  // namespace

@@ -33,7 +33,8 @@ inline Eigen::Matrix3d axisAngle(const Eigen::Vector3d& axis, double angle) {
   return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
 }
 
-/// Rotation vector uniformly distributed in the ball of radius `radius` (the paper's |v| < r noise).
+/// Rotation vector uniformly distributed in the ball of radius `radius` (the paper's |v| < r
+/// noise).
 inline Eigen::Vector3d uniformBall(std::mt19937_64& rng, double radius) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   Eigen::Vector3d v;
@@ -75,7 +76,8 @@ inline RotationPair exactPair(const Eigen::Matrix3d& X, const Eigen::Matrix3d& B
 
 /// J independent pairs with B uniformly random, and each side right-multiplied by Exp(v) with v
 /// uniform in the ball of radius noise_rad (the paper's simulation).
-inline RotationPairs paperPairs(std::mt19937_64& rng, const Eigen::Matrix3d& X, int J, double noise_rad) {
+inline RotationPairs paperPairs(std::mt19937_64& rng, const Eigen::Matrix3d& X, int J,
+                                double noise_rad) {
   RotationPairs pairs;
   for (int j = 0; j < J; ++j) {
     RotationPair p = exactPair(X, randomRotation(rng));

@@ -34,14 +34,17 @@ RotationPairs singleAxisPairs(std::mt19937_64& rng, const Eigen::Matrix3d& X,
 TEST(Observability, SingleAxisMotionIsNotObservableAndNamesTheAxis) {
   std::mt19937_64 rng(31);
   const std::vector<std::pair<Eigen::Vector3d, std::string>> axes = {
-      {Eigen::Vector3d::UnitX(), "x"}, {Eigen::Vector3d::UnitY(), "y"}, {Eigen::Vector3d::UnitZ(), "z"}};
+      {Eigen::Vector3d::UnitX(), "x"},
+      {Eigen::Vector3d::UnitY(), "y"},
+      {Eigen::Vector3d::UnitZ(), "z"}};
   for (double noise : {0.0, 0.002, 0.02}) {
     for (const auto& [axis, name] : axes) {
       const Eigen::Matrix3d X = randomRotation(rng);
       const AlignmentResult r = solveAlignment(singleAxisPairs(rng, X, axis, 20, noise));
       EXPECT_EQ(r.status, SolveStatus::kNotObservable) << "noise " << noise << " axis " << name;
       EXPECT_FALSE(r.quality.observable);
-      EXPECT_GT(std::abs(r.quality.weak_axis_cam.dot(axis)), 0.99) << r.quality.weak_axis_cam.transpose();
+      EXPECT_GT(std::abs(r.quality.weak_axis_cam.dot(axis)), 0.99)
+          << r.quality.weak_axis_cam.transpose();
       EXPECT_LT(std::abs(r.quality.excite_axis_cam.dot(axis)), 0.1);
       EXPECT_NE(r.message.find("about camera " + name), std::string::npos) << r.message;
       EXPECT_TRUE(r.R_cam_imu.allFinite());
@@ -59,8 +62,8 @@ TEST(Observability, OnePairIsNotObservable) {
 }
 
 TEST(Observability, NearlyDegenerateMotionIsObservableWithHonestSigma) {
-  // Rotations mostly about camera z, with an 8-degree tilt of the axis: observable, the 1-sigma about
-  // z is large, and it covers the true error.
+  // Rotations mostly about camera z, with an 8-degree tilt of the axis: observable, the 1-sigma
+  // about z is large, and it covers the true error.
   std::mt19937_64 rng(33);
   int covered = 0, total = 0;
   double mean_sigma_z = 0, mean_sigma_x = 0;
@@ -71,7 +74,8 @@ TEST(Observability, NearlyDegenerateMotionIsObservableWithHonestSigma) {
     std::uniform_real_distribution<double> angle(0.3, 1.5), phase(0, 2 * test::kPiTest);
     for (int j = 0; j < 20; ++j) {
       const double tilt = test::kPiTest * 8 / 180, ph = phase(rng);
-      const Eigen::Vector3d axis_cam(std::sin(tilt) * std::cos(ph), std::sin(tilt) * std::sin(ph), std::cos(tilt));
+      const Eigen::Vector3d axis_cam(std::sin(tilt) * std::cos(ph), std::sin(tilt) * std::sin(ph),
+                                     std::cos(tilt));
       RotationPair p = exactPair(X, axisAngle(X.transpose() * axis_cam, angle(rng)));
       p.A_cam = p.A_cam * test::rotationFromVector(test::gaussianVector(rng, 0.002));
       p.B_imu = p.B_imu * test::rotationFromVector(test::gaussianVector(rng, 0.002));
@@ -92,8 +96,8 @@ TEST(Observability, NearlyDegenerateMotionIsObservableWithHonestSigma) {
 }
 
 /// Fractions of (run, axis) errors within 1 and 3 reported sigmas.
-void coverage(const std::vector<Eigen::Vector3d>& err_deg, const std::vector<Eigen::Vector3d>& sigma_deg,
-              double* within1, double* within3) {
+void coverage(const std::vector<Eigen::Vector3d>& err_deg,
+              const std::vector<Eigen::Vector3d>& sigma_deg, double* within1, double* within3) {
   int n1 = 0, n3 = 0, n = 0;
   for (size_t k = 0; k < err_deg.size(); ++k) {
     for (int i = 0; i < 3; ++i) {
@@ -143,7 +147,8 @@ TEST(Observability, ReportedSigmaIsHonestForPairsSharingPoses) {
       const Eigen::Matrix3d R_world_imu = randomRotation(rng);
       PoseOrientation pose;
       pose.R_world_imu = R_world_imu * test::rotationFromVector(test::gaussianVector(rng, 0.008));
-      pose.R_target_cam = C * R_world_imu * X.transpose() * test::rotationFromVector(test::gaussianVector(rng, 0.002));
+      pose.R_target_cam = C * R_world_imu * X.transpose() *
+                          test::rotationFromVector(test::gaussianVector(rng, 0.002));
       poses.push_back(pose);
     }
     const AlignmentResult r = solveAlignment(makeAllPairs(poses));

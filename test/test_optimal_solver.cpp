@@ -47,14 +47,16 @@ TEST(OptimalSolver, NoiseFreeExactWithTwoNonParallelPairs) {
     const Eigen::Matrix3d X = randomRotation(rng);
     const Eigen::Vector3d b1 = randomUnitVector(rng);
     const Eigen::Vector3d b2 = (b1.cross(randomUnitVector(rng))).normalized();  // perpendicular
-    const RotationPairs pairs = {exactPair(X, axisAngle(b1, 0.7)), exactPair(X, axisAngle(b2, 1.1))};
+    const RotationPairs pairs = {exactPair(X, axisAngle(b1, 0.7)),
+                                 exactPair(X, axisAngle(b2, 1.1))};
     expectExact(pairs, X, "two pairs, trial " + std::to_string(trial));
   }
 }
 
 TEST(OptimalSolver, NoiseFreeExactNearIdentityAndNear180) {
   std::mt19937_64 rng(23);
-  for (double angle : {0.0, 1e-9, 1e-6, test::kPiTest - 1e-6, test::kPiTest - 1e-12, test::kPiTest}) {
+  for (double angle :
+       {0.0, 1e-9, 1e-6, test::kPiTest - 1e-6, test::kPiTest - 1e-12, test::kPiTest}) {
     for (int trial = 0; trial < 3; ++trial) {
       const Eigen::Matrix3d X = axisAngle(randomUnitVector(rng), angle);
       expectExact(exactPairs(rng, X, 20), X, "mounting angle " + std::to_string(angle));
@@ -69,7 +71,8 @@ TEST(OptimalSolver, PairsNear0And180DegreesGiveNoNaN) {
   const Eigen::Matrix3d X = randomRotation(rng);
   RotationPairs pairs = exactPairs(rng, X, 6);
   for (double angle : {0.0, 1e-12, 1e-8, test::kPiTest - 1e-10, test::kPiTest}) {
-    for (int k = 0; k < 3; ++k) pairs.push_back(exactPair(X, axisAngle(randomUnitVector(rng), angle)));
+    for (int k = 0; k < 3; ++k)
+      pairs.push_back(exactPair(X, axisAngle(randomUnitVector(rng), angle)));
   }
   const AlignmentResult r = solveAlignment(pairs);
   ASSERT_EQ(r.status, SolveStatus::kOk) << r.message;
@@ -81,7 +84,8 @@ TEST(OptimalSolver, PairsNear0And180DegreesGiveNoNaN) {
   EXPECT_TRUE(r.quality.std_dev_deg.allFinite());
   // Only 180-degree pairs (plus 0-degree ones): still solvable, exactly.
   RotationPairs half_turns;
-  for (const Eigen::Vector3d& b : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(1, 1, 1)}) {
+  for (const Eigen::Vector3d& b :
+       {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(1, 1, 1)}) {
     half_turns.push_back(exactPair(X, axisAngle(b, test::kPiTest)));
   }
   half_turns.push_back(exactPair(X, Eigen::Matrix3d::Identity()));

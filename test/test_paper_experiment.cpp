@@ -48,7 +48,8 @@ MonteCarlo runPaperExperiment() {
     // Fisher information of the small-angle model at the truth: r_j = (A_j - I) delta + e_j.
     Eigen::Matrix3d fisher = Eigen::Matrix3d::Zero();
     for (const auto& p : pairs) {
-      const Eigen::Matrix3d A_true = R0 * p.B_imu * R0.transpose();  // noise on A is O(noise^2) here
+      const Eigen::Matrix3d A_true =
+          R0 * p.B_imu * R0.transpose();  // noise on A is O(noise^2) here
       const Eigen::Matrix3d J = A_true - Eigen::Matrix3d::Identity();
       fisher += J.transpose() * J / residual_var;
     }

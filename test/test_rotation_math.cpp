@@ -11,8 +11,8 @@ namespace {
 
 TEST(RotationMath, ExpLogRoundTripOverAllAngles) {
   std::mt19937_64 rng(1);
-  for (double angle : {0.0, 1e-12, 1e-9, 1e-6, 0.01, 0.099, 0.1, 0.5, 1.0, 2.0, 2.7, 3.0, kPi - 1e-6,
-                       kPi - 1e-9}) {
+  for (double angle : {0.0, 1e-12, 1e-9, 1e-6, 0.01, 0.099, 0.1, 0.5, 1.0, 2.0, 2.7, 3.0,
+                       kPi - 1e-6, kPi - 1e-9}) {
     for (int trial = 0; trial < 20; ++trial) {
       const Eigen::Vector3d axis = test::randomUnitVector(rng);
       const Eigen::Vector3d v = angle * axis;
@@ -27,8 +27,9 @@ TEST(RotationMath, ExpLogRoundTripOverAllAngles) {
 }
 
 TEST(RotationMath, LogAtExactlyPiGivesTheAxisUpToSign) {
-  for (const Eigen::Vector3d& axis : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0),
-                                      Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(1.0 / 3, 2.0 / 3, -2.0 / 3)}) {
+  for (const Eigen::Vector3d& axis :
+       {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, 0, 1),
+        Eigen::Vector3d(1.0 / 3, 2.0 / 3, -2.0 / 3)}) {
     const Eigen::Matrix3d R = test::axisAngle(axis, kPi);
     const Eigen::Vector3d v = logSO3(R);
     ASSERT_TRUE(v.allFinite());
@@ -54,7 +55,8 @@ TEST(RotationMath, ProjectionReturnsTheNearestRotation) {
     EXPECT_NEAR(P.determinant(), 1.0, 1e-12);
     EXPECT_LT((P.transpose() * P - Eigen::Matrix3d::Identity()).norm(), 1e-12);
   }
-  // A reflection (det -1) becomes the nearest proper rotation: flip the smallest singular direction.
+  // A reflection (det -1) becomes the nearest proper rotation: flip the smallest singular
+  // direction.
   const Eigen::Matrix3d reflection = Eigen::Vector3d(1.0, 0.9, -0.1).asDiagonal();
   const Eigen::Matrix3d P = projectToSO3(reflection);
   EXPECT_LT((P - Eigen::Matrix3d::Identity()).norm(), 1e-12);

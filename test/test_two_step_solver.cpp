@@ -45,8 +45,12 @@ struct StackedSystem {
     for (int j = 0; j < H.cols() / 3; ++j) V.block(3 * j, 0, 3, 3) = H.block(0, 3 * j, 3, 3);
     return V;
   }
-  Eigen::Matrix3d rightStep(const Eigen::Matrix3d& R_left) const { return V2H(H1 * R_left) * pinv_H2; }
-  Eigen::Matrix3d leftStep(const Eigen::Matrix3d& R_right) const { return pinv_H1 * H2V(R_right * H2); }
+  Eigen::Matrix3d rightStep(const Eigen::Matrix3d& R_left) const {
+    return V2H(H1 * R_left) * pinv_H2;
+  }
+  Eigen::Matrix3d leftStep(const Eigen::Matrix3d& R_right) const {
+    return pinv_H1 * H2V(R_right * H2);
+  }
 };
 
 TEST(TwoStepSolver, IteratesFollowThePapersStackedFormulas) {
@@ -114,7 +118,8 @@ TEST(TwoStepSolver, GivenInitialValueSteersItToTheTruth) {
     RotationPairs pairs;
     for (int j = 0; j < 20; ++j) pairs.push_back(exactPair(X, randomRotation(rng)));
     TwoStepOptions options;
-    options.initial_R_cam_imu = test::axisAngle(test::randomUnitVector(rng), 1.0) * X;  // 57 deg off
+    options.initial_R_cam_imu =
+        test::axisAngle(test::randomUnitVector(rng), 1.0) * X;  // 57 deg off
     const TwoStepResult r = solveTwoStep(pairs, options);
     EXPECT_TRUE(r.converged);
     EXPECT_LT(angleBetweenDeg(r.R_cam_imu_left, X), 1e-8);
@@ -123,8 +128,8 @@ TEST(TwoStepSolver, GivenInitialValueSteersItToTheTruth) {
 
 TEST(TwoStepSolver, FromIdentityItCanLockOntoAWrongFixedPointForLargeMountings) {
   // A measured limitation of the paper's scheme: started from the identity, for mountings more than
-  // about 100 deg away it often converges (step below tolerance) to a wrong fixed point 180 deg off,
-  // even without noise. The default estimator must detect this and still be exact.
+  // about 100 deg away it often converges (step below tolerance) to a wrong fixed point 180 deg
+  // off, even without noise. The default estimator must detect this and still be exact.
   std::mt19937_64 rng(18);
   std::uniform_real_distribution<double> mount_angle(test::kPiTest * 150 / 180, test::kPiTest);
   int wrong = 0;

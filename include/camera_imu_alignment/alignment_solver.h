@@ -32,8 +32,8 @@ struct SolverOptions {
 enum class SolveStatus {
   kOk,             ///< estimate observable
   kNotObservable,  ///< estimate computed but a direction is unconstrained; see quality
-  kPoorFit,        ///< the two-step settled on a fixed point that fits far worse than the closed form
-  kBadInput,       ///< no pairs, or a pair that is not a rotation
+  kPoorFit,   ///< the two-step settled on a fixed point that fits far worse than the closed form
+  kBadInput,  ///< no pairs, or a pair that is not a rotation
 };
 
 struct AlignmentResult {

@@ -25,7 +25,8 @@ constexpr double kQuaternionNormTolerance = 1e-2;
 /// (pose indices -1). Throws InputError.
 RotationPairs readPairsCsv(const std::string& path);
 
-/// Poses file: stamp, cam_qw..cam_qz (q_target_cam), imu_qw..imu_qz (q_world_imu). Throws InputError.
+/// Poses file: stamp, cam_qw..cam_qz (q_target_cam), imu_qw..imu_qz (q_world_imu). Throws
+/// InputError.
 std::vector<PoseOrientation> readPosesCsv(const std::string& path);
 
 /// Writes a pairs file (header + one row per pair).

@@ -30,13 +30,13 @@ struct ExampleData {
   std::vector<PoseOrientation> poses;
 };
 
-/// Stationary poses of a rig looking at a target: R_target_cam = R_target_world R_world_imu R_cam_imu^T,
-/// each orientation perturbed on the right by Gaussian noise.
+/// Stationary poses of a rig looking at a target: R_target_cam = R_target_world R_world_imu
+/// R_cam_imu^T, each orientation perturbed on the right by Gaussian noise.
 ExampleData generateExample(const ExampleOptions& options);
 
 /// J independent pairs: B_j uniformly random rotations, A_j = X B_j X^T, each side perturbed on the
 /// right by Exp(v), v uniform in the ball of radius `noise_radius_rad`.
-RotationPairs generateRandomPairs(unsigned int seed, int num_pairs, const Eigen::Matrix3d& R_cam_imu,
-                                  double noise_radius_rad);
+RotationPairs generateRandomPairs(unsigned int seed, int num_pairs,
+                                  const Eigen::Matrix3d& R_cam_imu, double noise_radius_rad);
 
 }  // namespace camera_imu_alignment

@@ -13,7 +13,7 @@ namespace camera_imu_alignment {
 struct ResultMetadata {
   std::string camera_frame = "camera_optical_frame";  ///< image header frame_id
   std::string imu_frame = "imu_link";                 ///< Imu header frame_id
-  int num_poses = 0;                                  ///< stationary poses behind the pairs (0: pairs given)
+  int num_poses = 0;  ///< stationary poses behind the pairs (0: pairs given)
 };
 
 /// The result document as YAML text.
@@ -21,7 +21,8 @@ std::string resultToYaml(const AlignmentResult& result, const ResultMetadata& me
 
 /// Writes the YAML atomically (temporary file in the same folder + rename), so a reader never sees
 /// a half-written file and a failed write leaves any previous file intact. Throws InputError.
-void writeResultYaml(const std::string& path, const AlignmentResult& result, const ResultMetadata& meta);
+void writeResultYaml(const std::string& path, const AlignmentResult& result,
+                     const ResultMetadata& meta);
 
 /// R_cam_imu and frames read back from a result (or truth) YAML.
 struct StoredCalibration {

@@ -1,9 +1,9 @@
 // Residuals, uncertainty and observability of an R_cam_imu estimate.
 //
 // Residual of pair j at X = R_cam_imu:  r_j = Log(A_j X B_j^T X^T)  (rad, camera frame; zero when
-// A_j X = X B_j). Perturbations are on the left, X <- Exp(delta) X, so delta, the covariance and the
-// 1-sigma values are about the camera x, y, z axes. The error of an estimate against the truth is
-// Log(X_est X_true^T) in the same frame.
+// A_j X = X B_j). Perturbations are on the left, X <- Exp(delta) X, so delta, the covariance and
+// the 1-sigma values are about the camera x, y, z axes. The error of an estimate against the truth
+// is Log(X_est X_true^T) in the same frame.
 #pragma once
 
 #include <Eigen/Core>
@@ -43,8 +43,8 @@ struct SolutionQuality {
   double weakest_excitation_deg = 0.0;
   /// Unit direction (camera frame) about which R_cam_imu is least constrained.
   Eigen::Vector3d weak_axis_cam = Eigen::Vector3d::UnitZ();
-  /// Unit direction (camera frame) to rotate the rig about to constrain weak_axis_cam: perpendicular
-  /// to it, along the best-constrained direction.
+  /// Unit direction (camera frame) to rotate the rig about to constrain weak_axis_cam:
+  /// perpendicular to it, along the best-constrained direction.
   Eigen::Vector3d excite_axis_cam = Eigen::Vector3d::UnitX();
   int num_pairs = 0;
   int num_inliers = 0;

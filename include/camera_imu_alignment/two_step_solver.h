@@ -3,9 +3,9 @@
 // V2H / H2V block reshapes, alternating a right and a left update, each projected onto SO(3).
 //
 // It is an SVD power method: pinv(H2) = H2^T / J, so each update applies X -> (1/J) sum A_j X B_j^T
-// (or its adjoint) and converges to that operator's top singular vector, which is close to, but not,
-// the least-squares optimum. Use OptimalSolver for the best estimate; this solver runs first at every
-// solve and can be selected alone.
+// (or its adjoint) and converges to that operator's top singular vector, which is close to, but
+// not, the least-squares optimum. Use OptimalSolver for the best estimate; this solver runs first
+// at every solve and can be selected alone.
 #pragma once
 
 #include <Eigen/Core>
@@ -31,18 +31,18 @@ struct TwoStepOptions {
 /// One iteration n of the two-step scheme.
 struct TwoStepIterate {
   int iteration = 0;
-  Eigen::Matrix3d R_right;  ///< R^r_n (camera <- IMU)
-  Eigen::Matrix3d R_left;   ///< R^l_n (camera <- IMU)
-  double right_step_rad = 0.0;  ///< geodesic change of R^r from iteration n-1
-  double left_step_rad = 0.0;   ///< geodesic change of R^l from iteration n-1
+  Eigen::Matrix3d R_right;        ///< R^r_n (camera <- IMU)
+  Eigen::Matrix3d R_left;         ///< R^l_n (camera <- IMU)
+  double right_step_rad = 0.0;    ///< geodesic change of R^r from iteration n-1
+  double left_step_rad = 0.0;     ///< geodesic change of R^l from iteration n-1
   bool right_sign_fixed = false;  ///< the right update had det < 0 and was negated
   bool left_sign_fixed = false;   ///< the left update had det < 0 and was negated
 };
 
 struct TwoStepResult {
-  bool valid = false;        ///< false when fewer than one pair or non-finite input
-  bool converged = false;    ///< both iterates moved less than the tolerance
-  int iterations = 0;        ///< iterations run
+  bool valid = false;      ///< false when fewer than one pair or non-finite input
+  bool converged = false;  ///< both iterates moved less than the tolerance
+  int iterations = 0;      ///< iterations run
   Eigen::Matrix3d R_cam_imu_left = Eigen::Matrix3d::Identity();   ///< last R^l: the answer
   Eigen::Matrix3d R_cam_imu_right = Eigen::Matrix3d::Identity();  ///< last R^r
   double left_right_disagreement_rad = 0.0;  ///< geodesic angle between R^l and R^r

@@ -63,23 +63,25 @@ AlignmentResult solveAlignment(const RotationPairs& pairs, const SolverOptions& 
     result.message = "the solver produced no finite estimate";
     return result;
   }
-  result.quality = evaluateQuality(pairs, result.R_cam_imu, inlier, rejection, options.quality, residuals);
+  result.quality =
+      evaluateQuality(pairs, result.R_cam_imu, inlier, rejection, options.quality, residuals);
   result.status = result.quality.observable ? SolveStatus::kOk : SolveStatus::kNotObservable;
   if (options.method == SolverMethod::kTwoStep) {
-    // The two-step can converge to a wrong fixed point (mountings far from its initial value) or not
-    // converge at all; compare its fit with the closed form's so that this is never silent.
+    // The two-step can converge to a wrong fixed point (mountings far from its initial value) or
+    // not converge at all; compare its fit with the closed form's so that this is never silent.
     const auto reference = solveClosedForm(pairs);
     if (reference) {
       const double reference_rms = evaluateQuality(pairs, *reference).residual_rms_deg;
       if (result.quality.residual_rms_deg > 2.0 * reference_rms + 1.0) {
         char msg[400];
-        std::snprintf(msg, sizeof(msg),
-                      "the two-step %s at a rotation that does not fit the pairs (residual RMS %.3g deg; "
-                      "the closed form fits to %.3g deg, %.3g deg away): it is known to lock onto a wrong "
-                      "fixed point when the mounting is far from its initial value; use the optimal "
-                      "method or give an initial value",
-                      result.converged ? "converged" : "stopped", result.quality.residual_rms_deg,
-                      reference_rms, rad2deg(geodesicDistance(*reference, result.R_cam_imu)));
+        std::snprintf(
+            msg, sizeof(msg),
+            "the two-step %s at a rotation that does not fit the pairs (residual RMS %.3g deg; "
+            "the closed form fits to %.3g deg, %.3g deg away): it is known to lock onto a wrong "
+            "fixed point when the mounting is far from its initial value; use the optimal "
+            "method or give an initial value",
+            result.converged ? "converged" : "stopped", result.quality.residual_rms_deg,
+            reference_rms, rad2deg(geodesicDistance(*reference, result.R_cam_imu)));
         result.status = SolveStatus::kPoorFit;
         result.message = msg;
         return result;
@@ -89,10 +91,12 @@ AlignmentResult solveAlignment(const RotationPairs& pairs, const SolverOptions& 
   if (result.quality.observable) {
     char msg[256];
     const Eigen::Vector3d& sd = result.quality.std_dev_deg;
-    std::snprintf(msg, sizeof(msg), "solved with %s: %d/%d pairs, residual RMS %.3g deg, 1-sigma [%.3g %.3g %.3g] deg%s",
-                  toString(options.method).c_str(), result.quality.num_inliers, result.quality.num_pairs,
-                  result.quality.residual_rms_deg, sd.x(), sd.y(), sd.z(),
-                  result.converged ? "" : " (iteration limit reached before convergence)");
+    std::snprintf(
+        msg, sizeof(msg),
+        "solved with %s: %d/%d pairs, residual RMS %.3g deg, 1-sigma [%.3g %.3g %.3g] deg%s",
+        toString(options.method).c_str(), result.quality.num_inliers, result.quality.num_pairs,
+        result.quality.residual_rms_deg, sd.x(), sd.y(), sd.z(),
+        result.converged ? "" : " (iteration limit reached before convergence)");
     result.message = msg;
   } else {
     result.message = result.quality.observability_message;

@@ -72,8 +72,10 @@ class CsvTable {
     char* end = nullptr;
     errno = 0;
     const double v = std::strtod(text, &end);
-    if (end == text || *end != '\0') fail(row, "column " + column + ": '" + cells[c] + "' is not a number");
-    if (!std::isfinite(v) || errno == ERANGE) fail(row, "column " + column + ": value '" + cells[c] + "' is not finite");
+    if (end == text || *end != '\0')
+      fail(row, "column " + column + ": '" + cells[c] + "' is not a number");
+    if (!std::isfinite(v) || errno == ERANGE)
+      fail(row, "column " + column + ": value '" + cells[c] + "' is not finite");
     return v;
   }
 
@@ -125,8 +127,10 @@ std::vector<PoseOrientation> readPosesCsv(const std::string& path) {
   std::vector<PoseOrientation> poses(table.size());
   for (size_t i = 0; i < table.size(); ++i) {
     poses[i].stamp_s = table.value(i, "stamp");
-    poses[i].R_target_cam = table.quaternion(i, "cam_qw", "cam_qx", "cam_qy", "cam_qz").toRotationMatrix();
-    poses[i].R_world_imu = table.quaternion(i, "imu_qw", "imu_qx", "imu_qy", "imu_qz").toRotationMatrix();
+    poses[i].R_target_cam =
+        table.quaternion(i, "cam_qw", "cam_qx", "cam_qy", "cam_qz").toRotationMatrix();
+    poses[i].R_world_imu =
+        table.quaternion(i, "imu_qw", "imu_qx", "imu_qy", "imu_qz").toRotationMatrix();
   }
   return poses;
 }

@@ -37,21 +37,22 @@ ExampleData generateExample(const ExampleOptions& o) {
     const double yaw = deg2rad(o.yaw_range_deg) * unit(rng);
     const double pitch = deg2rad(o.tilt_range_deg) * unit(rng);
     const double roll = deg2rad(o.tilt_range_deg) * unit(rng);
-    const Eigen::Matrix3d R_world_imu =
-        (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-         Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
-            .toRotationMatrix();
+    const Eigen::Matrix3d R_world_imu = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                                         Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                                         Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+                                            .toRotationMatrix();
     PoseOrientation pose;
     pose.stamp_s = 5.0 * k;
     pose.R_world_imu = R_world_imu * noise(o.imu_noise_deg);
-    pose.R_target_cam = R_target_world * R_world_imu * data.R_cam_imu.transpose() * noise(o.camera_noise_deg);
+    pose.R_target_cam =
+        R_target_world * R_world_imu * data.R_cam_imu.transpose() * noise(o.camera_noise_deg);
     data.poses.push_back(pose);
   }
   return data;
 }
 
-RotationPairs generateRandomPairs(unsigned int seed, int num_pairs, const Eigen::Matrix3d& R_cam_imu,
-                                  double noise_radius_rad) {
+RotationPairs generateRandomPairs(unsigned int seed, int num_pairs,
+                                  const Eigen::Matrix3d& R_cam_imu, double noise_radius_rad) {
   std::mt19937_64 rng(seed);
   RotationPairs pairs(static_cast<size_t>(num_pairs));
   for (auto& p : pairs) {

@@ -68,8 +68,8 @@ double inlierThreshold(const std::vector<double>& norms, const OptimalOptions& o
 bool minimalSolution(const RotationPair& p1, const RotationPair& p2, Eigen::Matrix3d* X) {
   const Eigen::Vector3d a1 = logSO3(p1.A_cam), a2 = logSO3(p2.A_cam);
   const Eigen::Vector3d b1 = logSO3(p1.B_imu), b2 = logSO3(p2.B_imu);
-  const Eigen::Matrix3d M = a1 * b1.transpose() + a2 * b2.transpose() +
-                            a1.cross(a2) * b1.cross(b2).transpose();
+  const Eigen::Matrix3d M =
+      a1 * b1.transpose() + a2 * b2.transpose() + a1.cross(a2) * b1.cross(b2).transpose();
   *X = projectToSO3(M);
   return X->allFinite();
 }
@@ -115,7 +115,8 @@ int refineRotation(const RotationPairs& pairs, const std::vector<int>& indices,
     double tolerance = settings.step_tolerance_rad;
     if (scale <= 0.0) {
       const double sigma = std::sqrt(cost / dof * H.inverse().trace());
-      if (std::isfinite(sigma)) tolerance = std::max(tolerance, settings.relative_step_tolerance * sigma);
+      if (std::isfinite(sigma))
+        tolerance = std::max(tolerance, settings.relative_step_tolerance * sigma);
     }
     bool accepted = false;
     for (int attempt = 0; attempt < 20 && !accepted; ++attempt) {
@@ -162,15 +163,17 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
     angle_diff[j] = std::abs(rotationAngle(pairs[j].A_cam) - rotationAngle(pairs[j].B_imu));
   }
   std::vector<int> gated;
-  const double gate = std::max(deg2rad(o.angle_gate_min_deg), o.angle_gate_sigmas * 1.4826 * median(angle_diff));
+  const double gate =
+      std::max(deg2rad(o.angle_gate_min_deg), o.angle_gate_sigmas * 1.4826 * median(angle_diff));
   for (int j = 0; j < n; ++j) {
     if (!o.reject_outliers || angle_diff[j] <= gate) {
       gated.push_back(j);
       continue;
     }
     result.inlier[j] = false;
-    result.rejection[j] = "camera and IMU rotation angles differ by " + std::to_string(rad2deg(angle_diff[j])) +
-                          " deg (gate " + std::to_string(rad2deg(gate)) + " deg)";
+    result.rejection[j] = "camera and IMU rotation angles differ by " +
+                          std::to_string(rad2deg(angle_diff[j])) + " deg (gate " +
+                          std::to_string(rad2deg(gate)) + " deg)";
   }
   if (gated.empty()) return result;
 
@@ -206,23 +209,30 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
   if (!X.allFinite()) return result;
   const Eigen::Matrix3d X_start = X;
 
-  // 3. Consensus.
+  // 3. Least squares on the gated pairs, then the consensus test at that fit (testing at the start
+  //    would flag good pairs: the two-step's bias inflates some residuals).
+  std::vector<Eigen::Vector3d> residuals = start_residuals;
+  bool converged = false;
+  result.iterations += refineRotation(pairs, gated, settings(0.0), &X, &converged, &residuals);
   std::vector<int> inliers = gated;
   if (o.reject_outliers && gated.size() > 2) {
-    auto classify = [&](const Eigen::Matrix3d& R, double threshold) {
+    const auto classify = [&](const Eigen::Matrix3d& R, double threshold) {
       std::vector<int> in;
       for (int j : gated) {
         if (pairResidual(pairs[j], R).norm() <= threshold) in.push_back(j);
       }
       return in;
     };
-    double threshold = inlierThreshold(start_norms, o);
+    const std::vector<double> norms = normsOf(residuals, gated.size());
+    double threshold = inlierThreshold(norms, o);
     inliers.clear();
     for (size_t i = 0; i < gated.size(); ++i) {
-      if (start_norms[i] <= threshold) inliers.push_back(gated[i]);
+      if (norms[i] <= threshold) inliers.push_back(gated[i]);
     }
     if (inliers.size() < gated.size()) {
-      // Suspected outliers: robust refit from the start, then RANSAC for a larger consensus.
+      // Suspected outliers: the least-squares fit may have been dragged by them. Robust (Cauchy)
+      // refit from the start, then RANSAC over two-pair minimal solutions for a larger consensus.
+      X = X_start;
       bool conv = false;
       const double scale = std::max(deg2rad(o.inlier_min_deg), threshold / o.inlier_sigmas);
       result.iterations += refineRotation(pairs, gated, settings(scale), &X, &conv);
@@ -236,7 +246,13 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
         result.ransac_used = true;
         std::mt19937 rng(o.seed);
         std::uniform_int_distribution<size_t> pick(0, samples.size() - 1);
-        for (int h = 0; h < o.ransac_hypotheses; ++h) {
+        // Adaptive stop: enough hypotheses to draw an all-inlier pair with 99.9% probability at the
+        // current inlier ratio w: log(0.001) / log(1 - w^2).
+        const auto needed = [&]() {
+          const double w = static_cast<double>(inliers.size()) / gated.size();
+          return w >= 1.0 ? 0.0 : std::log(1e-3) / std::log(std::max(1e-12, 1.0 - w * w));
+        };
+        for (int h = 0; h < o.ransac_hypotheses && h < needed(); ++h) {
           const int i1 = samples[pick(rng)], i2 = samples[pick(rng)];
           if (i1 == i2) continue;
           Eigen::Matrix3d X_h;
@@ -253,20 +269,17 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
           }
         }
       }
+      if (inliers.size() < 2) inliers = gated;  // never fit fewer pairs than the minimum
+      // 4. Final least squares on the inliers.
+      residuals.clear();
+      result.iterations += refineRotation(pairs, inliers, settings(0.0), &X, &converged, &residuals);
     }
-    if (inliers.size() < 2) inliers = gated;  // never fit fewer pairs than the minimum
   }
-
-  // 4. Final least squares on the inliers (reusing the start residuals when nothing changed).
-  std::vector<Eigen::Vector3d> final_residuals;
-  if (inliers == gated && X == X_start) final_residuals = start_residuals;
-  bool converged = false;
-  result.iterations += refineRotation(pairs, inliers, settings(0.0), &X, &converged, &final_residuals);
   result.converged = converged;
   result.R_cam_imu = X;
   result.valid = X.allFinite();
   result.residuals.assign(n, Eigen::Vector3d::Zero());
-  for (size_t i = 0; i < inliers.size(); ++i) result.residuals[inliers[i]] = final_residuals[i];
+  for (size_t i = 0; i < inliers.size(); ++i) result.residuals[inliers[i]] = residuals[i];
 
   std::vector<bool> is_inlier(n, false);
   for (int j : inliers) is_inlier[j] = true;

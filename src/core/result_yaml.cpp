@@ -34,7 +34,8 @@ std::string quaternionXyzw(const Eigen::Matrix3d& R) {
   q.normalize();
   if (q.w() < 0.0) q.coeffs() = -q.coeffs();  // canonical sign; q and -q are the same rotation
   std::ostringstream out;
-  out << std::setprecision(12) << "[" << q.x() << ", " << q.y() << ", " << q.z() << ", " << q.w() << "]";
+  out << std::setprecision(12) << "[" << q.x() << ", " << q.y() << ", " << q.z() << ", " << q.w()
+      << "]";
   return out.str();
 }
 
@@ -57,7 +58,8 @@ std::string resultToYaml(const AlignmentResult& r, const ResultMetadata& meta) {
   writeRotation(out, "R_cam_imu", "p_cam = R_cam_imu * p_imu", R);
   out << "T_cam_imu:  # Kalibr camchain-imucam convention, translation zero\n";
   for (int i = 0; i < 3; ++i) {
-    out << "  - [" << std::setprecision(9) << R(i, 0) << ", " << R(i, 1) << ", " << R(i, 2) << ", 0.0]\n";
+    out << "  - [" << std::setprecision(9) << R(i, 0) << ", " << R(i, 1) << ", " << R(i, 2)
+        << ", 0.0]\n";
   }
   out << "  - [0.0, 0.0, 0.0, 1.0]\n" << std::setprecision(6);
   writeRotation(out, "R_imu_cam", "p_imu = R_imu_cam * p_cam (OpenVINS / VINS-Mono direction)",
@@ -93,13 +95,17 @@ std::string resultToYaml(const AlignmentResult& r, const ResultMetadata& meta) {
   out << "  two_step:  # the paper's iteration, run at every solve\n";
   out << "    converged: " << (r.two_step.converged ? "true" : "false") << "\n";
   out << "    iterations: " << r.two_step.iterations << "\n";
-  out << "    R_cam_imu_left_quaternion_xyzw: " << quaternionXyzw(r.two_step.R_cam_imu_left) << "\n";
-  out << "    R_cam_imu_right_quaternion_xyzw: " << quaternionXyzw(r.two_step.R_cam_imu_right) << "\n";
-  out << "    difference_to_result_deg: " << rad2deg(geodesicDistance(r.two_step.R_cam_imu_left, R)) << "\n";
+  out << "    R_cam_imu_left_quaternion_xyzw: " << quaternionXyzw(r.two_step.R_cam_imu_left)
+      << "\n";
+  out << "    R_cam_imu_right_quaternion_xyzw: " << quaternionXyzw(r.two_step.R_cam_imu_right)
+      << "\n";
+  out << "    difference_to_result_deg: " << rad2deg(geodesicDistance(r.two_step.R_cam_imu_left, R))
+      << "\n";
   return out.str();
 }
 
-void writeResultYaml(const std::string& path, const AlignmentResult& result, const ResultMetadata& meta) {
+void writeResultYaml(const std::string& path, const AlignmentResult& result,
+                     const ResultMetadata& meta) {
   const std::string tmp = path + ".tmp";
   {
     std::ofstream out(tmp);

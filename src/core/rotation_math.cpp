@@ -34,7 +34,8 @@ Eigen::Vector3d logSO3(const Eigen::Matrix3d& R) {
                     s2 * (3.0 / 40.0 +
                           s2 * (5.0 / 112.0 +
                                 s2 * (35.0 / 1152.0 +
-                                      s2 * (63.0 / 2816.0 + s2 * (231.0 / 13312.0 + s2 * (143.0 / 10240.0)))))));
+                                      s2 * (63.0 / 2816.0 +
+                                            s2 * (231.0 / 13312.0 + s2 * (143.0 / 10240.0)))))));
     return half_vee * ratio;
   }
   if (cos_angle > -0.9) {
@@ -50,7 +51,8 @@ Eigen::Vector3d logSO3(const Eigen::Matrix3d& R) {
 }
 
 double rotationAngle(const Eigen::Matrix3d& R) {
-  // sin(theta) from the skew part, cos(theta) from the trace: atan2 of both is accurate at 0 and pi.
+  // sin(theta) from the skew part, cos(theta) from the trace: atan2 of both is accurate at 0 and
+  // pi.
   const Eigen::Vector3d vee(R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1));
   return std::atan2(0.5 * vee.norm(), 0.5 * (R.trace() - 1.0));
 }
@@ -71,10 +73,10 @@ Eigen::Matrix3d projectToSO3BySvd(const Eigen::Matrix3d& M) {
 }  // namespace
 
 Eigen::Matrix3d projectToSO3(const Eigen::Matrix3d& M) {
-  // For det(M) > 0 the nearest rotation is the orthogonal polar factor U V^T of M = U S V^T. Higham's
-  // scaled Newton iteration X <- (g X + X^-T / g) / 2 converges to exactly that matrix, quadratically,
-  // in a handful of 3x3 inversions (about 5x faster than a 3x3 Jacobi SVD). Near-singular or
-  // det <= 0 input goes through the SVD with the determinant fix.
+  // For det(M) > 0 the nearest rotation is the orthogonal polar factor U V^T of M = U S V^T.
+  // Higham's scaled Newton iteration X <- (g X + X^-T / g) / 2 converges to exactly that matrix,
+  // quadratically, in a handful of 3x3 inversions (about 5x faster than a 3x3 Jacobi SVD).
+  // Near-singular or det <= 0 input goes through the SVD with the determinant fix.
   const double norm = M.norm();
   const double det = M.determinant();
   if (!(norm > 0.0) || !std::isfinite(norm) || det <= 1e-6 * norm * norm * norm) {
@@ -108,7 +110,8 @@ double jacobianInverseCoefficient(double angle) {
 
 Eigen::Matrix3d leftJacobianInverse(const Eigen::Vector3d& phi) {
   const Eigen::Matrix3d Phi = skew(phi);
-  return Eigen::Matrix3d::Identity() - 0.5 * Phi + jacobianInverseCoefficient(phi.norm()) * Phi * Phi;
+  return Eigen::Matrix3d::Identity() - 0.5 * Phi +
+         jacobianInverseCoefficient(phi.norm()) * Phi * Phi;
 }
 
 bool isRotationMatrix(const Eigen::Matrix3d& R, double tolerance) {

@@ -14,7 +14,8 @@ namespace {
 /// e_kt = A_kt w_t - w_k, w_p ~ N(0, s2 I) the (camera-frame) noise of pose p. With g_p the sum of
 /// J^T times the coefficient of w_p over the pairs that use pose p and G = sum_p g_p g_p^T:
 ///   Cov(delta) = s2 H^-1 G H^-1,  E[sum |r|^2] = s2 (6 N - tr(H^-1 G)).
-/// For independent pairs (e_j ~ N(0, s2 I)) the same algebra gives G = H and 3N - 3 degrees of freedom.
+/// For independent pairs (e_j ~ N(0, s2 I)) the same algebra gives G = H and 3N - 3 degrees of
+/// freedom.
 struct NoiseModel {
   Eigen::Matrix3d G = Eigen::Matrix3d::Zero();
   double noise_dims = 0.0;  // tr(S_e) / s2
@@ -67,7 +68,8 @@ SolutionQuality evaluateQuality(const RotationPairs& pairs, const Eigen::Matrix3
   double sum_sq = 0.0;
   for (size_t j = 0; j < pairs.size(); ++j) {
     PairDiagnostics& d = q.pairs[j];
-    residuals[j] = given_residuals.size() == pairs.size() ? given_residuals[j] : pairResidual(pairs[j], R_cam_imu);
+    residuals[j] = given_residuals.size() == pairs.size() ? given_residuals[j]
+                                                          : pairResidual(pairs[j], R_cam_imu);
     d.residual_deg = rad2deg(residuals[j].norm());
     pairAnglesDeg(pairs[j], &d.angle_cam_deg, &d.angle_imu_deg);
     d.inlier = inlier.empty() || inlier[j];
@@ -127,27 +129,30 @@ SolutionQuality evaluateQuality(const RotationPairs& pairs, const Eigen::Matrix3
       residual_var = sum_sq / dof;
       q.covariance_rad2 = residual_var * H_inv * model.G * H_inv;
       for (int i = 0; i < 3; ++i) {
-        q.std_dev_deg(i) = std::min(180.0, rad2deg(std::sqrt(std::max(0.0, q.covariance_rad2(i, i)))));
+        q.std_dev_deg(i) =
+            std::min(180.0, rad2deg(std::sqrt(std::max(0.0, q.covariance_rad2(i, i)))));
       }
     }
   }
   const double noise_deg = rad2deg(std::sqrt(residual_var));
-  const double needed_deg = std::max(options.min_excitation_deg,
-                                     options.min_excitation_noise_ratio * noise_deg);
+  const double needed_deg =
+      std::max(options.min_excitation_deg, options.min_excitation_noise_ratio * noise_deg);
   char msg[512];
   if (used.size() < 2 || lambda(0) <= tiny || q.weakest_excitation_deg < needed_deg) {
     q.observable = false;
     const std::string weak = axisName(q.weak_axis_cam);
     const char* others = weak == "x" ? "y or z" : weak == "y" ? "x or z" : "x or y";
-    std::snprintf(msg, sizeof(msg),
-                  "not observable: the rotations were (nearly) all about camera %s (axis [%.3f %.3f "
-                  "%.3f]; excitation of the other axes %.3g deg, needs %.3g deg), so R_cam_imu is "
-                  "free about it; rotate the rig about the camera %s axis (best: camera %s)",
-                  weak.c_str(), q.weak_axis_cam.x(), q.weak_axis_cam.y(), q.weak_axis_cam.z(),
-                  q.weakest_excitation_deg, needed_deg, others, axisName(q.excite_axis_cam).c_str());
+    std::snprintf(
+        msg, sizeof(msg),
+        "not observable: the rotations were (nearly) all about camera %s (axis [%.3f %.3f "
+        "%.3f]; excitation of the other axes %.3g deg, needs %.3g deg), so R_cam_imu is "
+        "free about it; rotate the rig about the camera %s axis (best: camera %s)",
+        weak.c_str(), q.weak_axis_cam.x(), q.weak_axis_cam.y(), q.weak_axis_cam.z(),
+        q.weakest_excitation_deg, needed_deg, others, axisName(q.excite_axis_cam).c_str());
   } else {
     q.observable = true;
-    std::snprintf(msg, sizeof(msg), "observable (observability %.3g, weakest excitation %.3g deg about camera %s)",
+    std::snprintf(msg, sizeof(msg),
+                  "observable (observability %.3g, weakest excitation %.3g deg about camera %s)",
                   q.observability, q.weakest_excitation_deg, axisName(q.weak_axis_cam).c_str());
   }
   q.observability_message = msg;

@@ -1,10 +1,9 @@
 // The paper's two-step iteration, written in the paper's own terms. The issue references the
 // paper's equations (11)-(19) for this part; each step below names the formula it implements:
-//   stacked system     H1 R0 = H2V(R0 H2),  H1 = [A_1; ...; A_J] (3J x 3), H2 = [B_1 ... B_J] (3 x 3J)
-//   right step         R^r_n = V2H(H1 R^l_{n-1}) pinv(H2)
-//   left step          R^l_n = pinv(H1) H2V(R^r_n H2)
-//   SVD projection     M = U S V^T -> U V^T, after negating M when det(M) < 0 (sign fix)
-//   stopping rule      successive iterates closer than a tolerance
+//   stacked system     H1 R0 = H2V(R0 H2),  H1 = [A_1; ...; A_J] (3J x 3), H2 = [B_1 ... B_J] (3 x
+//   3J) right step         R^r_n = V2H(H1 R^l_{n-1}) pinv(H2) left step          R^l_n = pinv(H1)
+//   H2V(R^r_n H2) SVD projection     M = U S V^T -> U V^T, after negating M when det(M) < 0 (sign
+//   fix) stopping rule      successive iterates closer than a tolerance
 // H1, H2 and the pseudo-inverses are kept as their 3x3 blocks and each step is applied as the 9x9
 // linear map it is (built once per solve); test_two_step_solver checks the iterates against the
 // formulas evaluated with explicitly stacked H1, H2 and Eigen's own pseudo-inverses.
@@ -53,8 +52,9 @@ TwoStepResult solveTwoStep(const RotationPairs& pairs, const TwoStepOptions& opt
   const Eigen::Matrix3d H1tH1_inv = H1tH1.inverse(), H2H2t_inv = H2H2t.inverse();
   // Both steps are linear in R before the projection. With column-major vec and
   // vec(L R M) = (M^T (x) L) vec(R):
-  //   right: vec(V2H(H1 R) pinv(H2)) = vec(sum_j A_j R P2_j) = K_right vec(R), K_right = sum_j P2_j^T (x) A_j
-  //   left:  vec(pinv(H1) H2V(R H2)) = vec(sum_j P1_j R B_j) = K_left vec(R),  K_left = sum_j B_j^T (x) P1_j
+  //   right: vec(V2H(H1 R) pinv(H2)) = vec(sum_j A_j R P2_j) = K_right vec(R), K_right = sum_j
+  //   P2_j^T (x) A_j left:  vec(pinv(H1) H2V(R H2)) = vec(sum_j P1_j R B_j) = K_left vec(R), K_left
+  //   = sum_j B_j^T (x) P1_j
   // The 9x9 operators are built once from the blocks of H1, H2 and their pseudo-inverses, so each
   // iteration costs two 9x9 products instead of 4J 3x3 products (same numbers, J-independent).
   using Matrix9 = Eigen::Matrix<double, 9, 9>;
@@ -64,7 +64,8 @@ TwoStepResult solveTwoStep(const RotationPairs& pairs, const TwoStepOptions& opt
     const Eigen::Matrix3d P2_j = pairs[j].B_imu.transpose() * H2H2t_inv;  // block j of pinv(H2)
     for (int c = 0; c < 3; ++c) {
       for (int r = 0; r < 3; ++r) {
-        K_right.block<3, 3>(3 * r, 3 * c) += P2_j(c, r) * pairs[j].A_cam;  // (P2_j^T)(r, c) = P2_j(c, r)
+        K_right.block<3, 3>(3 * r, 3 * c) +=
+            P2_j(c, r) * pairs[j].A_cam;  // (P2_j^T)(r, c) = P2_j(c, r)
         K_left.block<3, 3>(3 * r, 3 * c) += pairs[j].B_imu(c, r) * P1_j;
       }
     }

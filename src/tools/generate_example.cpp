@@ -16,17 +16,21 @@ namespace {
 
 const char* kUsage =
     "usage: generate_example --poses-out POSES.csv --truth-out TRUTH.yaml [--pairs-out PAIRS.csv]\n"
-    "                        [--seed N] [--num-poses N] [--camera-noise-deg X] [--imu-noise-deg X]\n"
-    "  Writes stationary poses (q_target_cam, q_world_imu) of a rig with a random R_cam_imu, and the\n"
+    "                        [--seed N] [--num-poses N] [--camera-noise-deg X] [--imu-noise-deg "
+    "X]\n"
+    "  Writes stationary poses (q_target_cam, q_world_imu) of a rig with a random R_cam_imu, and "
+    "the\n"
     "  truth. Noise is Gaussian per axis (defaults 0.1 deg camera, 0.5 deg IMU); 12 poses.\n";
 
-void writeTruth(const std::string& path, const cia::ExampleData& data, const cia::ExampleOptions& o) {
+void writeTruth(const std::string& path, const cia::ExampleData& data,
+                const cia::ExampleOptions& o) {
   Eigen::Quaterniond q(data.R_cam_imu);
   if (q.w() < 0.0) q.coeffs() = -q.coeffs();
   std::ofstream out(path);
   if (!out) throw cia::InputError(path + ": cannot write file");
   out << std::setprecision(15);
-  out << "# Ground truth of generate_example\ncamera_frame: camera_optical_frame\nimu_frame: imu_link\n"
+  out << "# Ground truth of generate_example\ncamera_frame: camera_optical_frame\nimu_frame: "
+         "imu_link\n"
       << "R_cam_imu:  # p_cam = R_cam_imu * p_imu\n"
       << "  quaternion_xyzw: [" << q.x() << ", " << q.y() << ", " << q.z() << ", " << q.w() << "]\n"
       << "  matrix: [";
@@ -35,7 +39,8 @@ void writeTruth(const std::string& path, const cia::ExampleData& data, const cia
         << data.R_cam_imu(i, 2) << "]";
   }
   out << "]\nseed: " << o.seed << "\nnum_poses: " << o.num_poses
-      << "\ncamera_noise_deg: " << o.camera_noise_deg << "\nimu_noise_deg: " << o.imu_noise_deg << "\n";
+      << "\ncamera_noise_deg: " << o.camera_noise_deg << "\nimu_noise_deg: " << o.imu_noise_deg
+      << "\n";
   if (!out) throw cia::InputError(path + ": write error");
 }
 
@@ -61,7 +66,8 @@ int main(int argc, char** argv) {
     o.imu_noise_deg = args.getDouble("--imu-noise-deg", o.imu_noise_deg, 0.0, 30.0);
     const cia::ExampleData data = cia::generateExample(o);
     cia::writePosesCsv(args.get("--poses-out"), data.poses);
-    if (args.has("--pairs-out")) cia::writePairsCsv(args.get("--pairs-out"), cia::makeAllPairs(data.poses));
+    if (args.has("--pairs-out"))
+      cia::writePairsCsv(args.get("--pairs-out"), cia::makeAllPairs(data.poses));
     writeTruth(args.get("--truth-out"), data, o);
     return 0;
   } catch (const cia::UsageError& e) {

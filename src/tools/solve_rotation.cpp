@@ -45,13 +45,14 @@ void printSummary(const cia::AlignmentResult& r) {
   const Eigen::Vector3d ypr = R.eulerAngles(2, 1, 0);
   std::cerr << std::fixed << std::setprecision(4);
   std::cerr << "R_cam_imu (p_cam = R_cam_imu * p_imu), method " << cia::toString(r.method) << ":\n"
-            << "  quaternion xyzw: [" << q.x() << ", " << q.y() << ", " << q.z() << ", " << q.w() << "]\n"
-            << "  yaw/pitch/roll (ZYX, deg): [" << cia::rad2deg(ypr(0)) << ", " << cia::rad2deg(ypr(1))
-            << ", " << cia::rad2deg(ypr(2)) << "]\n"
+            << "  quaternion xyzw: [" << q.x() << ", " << q.y() << ", " << q.z() << ", " << q.w()
+            << "]\n"
+            << "  yaw/pitch/roll (ZYX, deg): [" << cia::rad2deg(ypr(0)) << ", "
+            << cia::rad2deg(ypr(1)) << ", " << cia::rad2deg(ypr(2)) << "]\n"
             << "  1-sigma about camera x/y/z (deg): [" << r.quality.std_dev_deg.transpose() << "]\n"
             << "  residual RMS (deg): " << r.quality.residual_rms_deg << ", inliers "
-            << r.quality.num_inliers << "/" << r.quality.num_pairs << ", iterations " << r.iterations
-            << (r.converged ? "" : " (not converged)") << "\n"
+            << r.quality.num_inliers << "/" << r.quality.num_pairs << ", iterations "
+            << r.iterations << (r.converged ? "" : " (not converged)") << "\n"
             << "  paper's two-step: " << (r.two_step.converged ? "converged" : "NOT converged")
             << " in " << r.two_step.iterations << " iterations, "
             << cia::rad2deg(cia::geodesicDistance(r.two_step.R_cam_imu_left, R))
@@ -60,8 +61,8 @@ void printSummary(const cia::AlignmentResult& r) {
 
 int run(int argc, char** argv) {
   const cia::CliArgs args(argc, argv,
-                          {"--pairs", "--poses", "--method", "--max-iterations", "--output", "--truth",
-                           "--max-poses", "--camera-frame", "--imu-frame"},
+                          {"--pairs", "--poses", "--method", "--max-iterations", "--output",
+                           "--truth", "--max-poses", "--camera-frame", "--imu-frame"},
                           {"--help", "-h"});
   if (args.has("--help") || args.has("-h")) {
     std::cout << kUsage;
@@ -72,7 +73,8 @@ int run(int argc, char** argv) {
   }
   cia::SolverOptions options;
   if (args.has("--method") && !cia::parseSolverMethod(args.get("--method"), &options.method)) {
-    throw cia::UsageError("--method must be optimal or two_step, got '" + args.get("--method") + "'");
+    throw cia::UsageError("--method must be optimal or two_step, got '" + args.get("--method") +
+                          "'");
   }
   if (args.has("--max-iterations")) {
     const int n = static_cast<int>(args.getInt("--max-iterations", 100, 1, 1000000));
@@ -123,7 +125,8 @@ int run(int argc, char** argv) {
     std::cerr << "  error to the truth in " << args.get("--truth") << ": " << err
               << " deg (paper's two-step alone: " << err_two_step << " deg)\n";
   }
-  if (result.status == cia::SolveStatus::kNotObservable || result.status == cia::SolveStatus::kPoorFit) {
+  if (result.status == cia::SolveStatus::kNotObservable ||
+      result.status == cia::SolveStatus::kPoorFit) {
     std::cerr << result.message << "\n";
     return kExitNotObservable;
   }
