@@ -61,10 +61,10 @@ cv::Mat toCv(const Eigen::Vector3d& t) {
 DataSet makeDataSet(unsigned seed, int P, double cam_noise_deg, double imu_noise_deg) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> gauss(0.0, 1.0);
-  const auto translation_noise = [&]() {
+  const auto translation_noise = [&]() -> Eigen::Vector3d {
     return 0.002 * Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng));
   };
-  const auto noise = [&](double sigma_deg) {
+  const auto noise = [&](double sigma_deg) -> Eigen::Matrix3d {
     return cia::expSO3(cia::deg2rad(sigma_deg) *
                        Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)));
   };

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Shared by scripts/demo and scripts/test (sourced, not run): installs the Debian packages this
-# package needs, lays out the git-ignored catkin workspace .ws/ (whose src/camera_imu_alignment links
-# to the repository root) and builds it with catkin_make -j2.
+# Shared by scripts/demo, scripts/test and scripts/bench (sourced, not run): installs the Debian
+# packages this package needs, lays out the git-ignored catkin workspace .ws/ (whose
+# src/camera_imu_alignment links to the repository's files) and builds it with catkin_make -j2.
 
 REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 WS="${REPO_ROOT}/.ws"
@@ -37,9 +37,18 @@ cia_install_packages() {
     "${missing[@]}" >/dev/null
 }
 
+# .ws/src/camera_imu_alignment is a real directory of links to the repository's top-level entries,
+# never to .ws itself: a link to the whole repository would make .ws contain itself, and rosrun's
+# `find -L` would report a file-system loop on every call.
 cia_setup_workspace() {
+  local pkg="${WS}/src/camera_imu_alignment" entry
   mkdir -p "${WS}/src" "${ROS_HOME}"
-  ln -sfn "${REPO_ROOT}" "${WS}/src/camera_imu_alignment"
+  if [ -L "${pkg}" ]; then rm -f "${pkg}"; fi
+  mkdir -p "${pkg}"
+  find "${pkg}" -maxdepth 1 -type l -delete
+  for entry in "${REPO_ROOT}"/* "${REPO_ROOT}/.clang-format"; do
+    ln -sfn "${entry}" "${pkg}/$(basename "${entry}")"
+  done
 }
 
 # cia_build [extra catkin_make targets...]

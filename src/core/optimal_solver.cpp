@@ -272,7 +272,8 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
       if (inliers.size() < 2) inliers = gated;  // never fit fewer pairs than the minimum
       // 4. Final least squares on the inliers.
       residuals.clear();
-      result.iterations += refineRotation(pairs, inliers, settings(0.0), &X, &converged, &residuals);
+      result.iterations +=
+          refineRotation(pairs, inliers, settings(0.0), &X, &converged, &residuals);
     }
   }
   result.converged = converged;

@@ -89,7 +89,8 @@ SolutionQuality evaluateQuality(const RotationPairs& pairs, const Eigen::Matrix3
 
   // Observability from the spread of rotation axes: the information matrix H is about
   // sum_j 2 (1 - cos theta_j) (I - a_j a_j^T), blind along a common axis a.
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(0.5 * (H + H.transpose()));
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(0.5 * (H + H.transpose()));  // closed-form 3x3; ample for these diagnostics
   const Eigen::Vector3d lambda = eig.eigenvalues().cwiseMax(0.0);  // ascending
   const double mean_lambda = lambda.sum() / 3.0;
   q.observability = mean_lambda > 0.0 ? std::min(1.0, lambda(0) / mean_lambda) : 0.0;

@@ -53,8 +53,10 @@ void printSummary(const cia::AlignmentResult& r) {
             << "  residual RMS (deg): " << r.quality.residual_rms_deg << ", inliers "
             << r.quality.num_inliers << "/" << r.quality.num_pairs << ", iterations "
             << r.iterations << (r.converged ? "" : " (not converged)") << "\n"
-            << "  paper's two-step: " << (r.two_step.converged ? "converged" : "NOT converged")
-            << " in " << r.two_step.iterations << " iterations, "
+            << "  paper's two-step: "
+            << (r.two_step.converged ? "converged in " : "stopped without converging after ")
+            << r.two_step.iterations << " iterations"
+            << (r.method == cia::SolverMethod::kOptimal ? " (start: " + r.start + "), " : ", ")
             << cia::rad2deg(cia::geodesicDistance(r.two_step.R_cam_imu_left, R))
             << " deg from this result\n";
 }
