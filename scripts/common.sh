@@ -5,6 +5,7 @@
 
 REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 WS="${REPO_ROOT}/.ws"
+mkdir -p "${WS}"  # the scripts log into it before the first build
 
 # Debian's catkin and pluginlib need Debian's own python3 first on PATH (a pyenv python breaks the
 # configure step: "No module named catkin_pkg"). See ../shared/PLATFORM.md.
