@@ -136,20 +136,20 @@ void outlierExperiment(double outlier_fraction, double* rms_all, double* rms_inl
   *rms_inliers = std::sqrt(sum_in / runs);
 }
 
-TEST(OptimalSolver, TenPercentOutliersCostLessThanTwiceTheInlierOnlyError) {
+void expectOutliersCostLessThanTwiceTheInlierOnlyError(double outlier_fraction) {
   double rms_all, rms_in;
   int missed;
-  outlierExperiment(0.1, &rms_all, &rms_in, &missed);
+  outlierExperiment(outlier_fraction, &rms_all, &rms_in, &missed);
   EXPECT_LT(rms_all, 2.0 * rms_in) << "all " << rms_all << " inliers-only " << rms_in;
   EXPECT_EQ(missed, 0);
 }
 
+TEST(OptimalSolver, TenPercentOutliersCostLessThanTwiceTheInlierOnlyError) {
+  expectOutliersCostLessThanTwiceTheInlierOnlyError(0.1);
+}
+
 TEST(OptimalSolver, ThirtyPercentOutliersCostLessThanTwiceTheInlierOnlyError) {
-  double rms_all, rms_in;
-  int missed;
-  outlierExperiment(0.3, &rms_all, &rms_in, &missed);
-  EXPECT_LT(rms_all, 2.0 * rms_in) << "all " << rms_all << " inliers-only " << rms_in;
-  EXPECT_EQ(missed, 0);
+  expectOutliersCostLessThanTwiceTheInlierOnlyError(0.3);
 }
 
 TEST(OptimalSolver, MorePairsNeverMakeTheAnswerWorse) {

