@@ -216,19 +216,20 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
   result.iterations += refineRotation(pairs, gated, settings(0.0), &X, &converged, &residuals);
   std::vector<int> inliers = gated;
   if (o.reject_outliers && gated.size() > 2) {
-    const auto classify = [&](const Eigen::Matrix3d& R, double threshold) {
+    // Pairs of `gated` whose residual norm (same order) is within the threshold.
+    const auto select = [&gated](const std::vector<double>& norms, double threshold) {
       std::vector<int> in;
-      for (int j : gated) {
-        if (pairResidual(pairs[j], R).norm() <= threshold) in.push_back(j);
+      for (size_t i = 0; i < gated.size(); ++i) {
+        if (norms[i] <= threshold) in.push_back(gated[i]);
       }
       return in;
     };
+    const auto classify = [&](const Eigen::Matrix3d& R, double threshold) {
+      return select(residualNorms(pairs, gated, R), threshold);
+    };
     const std::vector<double> norms = normsOf(residuals, gated.size());
     double threshold = inlierThreshold(norms, o);
-    inliers.clear();
-    for (size_t i = 0; i < gated.size(); ++i) {
-      if (norms[i] <= threshold) inliers.push_back(gated[i]);
-    }
+    inliers = select(norms, threshold);
     if (inliers.size() < gated.size()) {
       // Suspected outliers: the least-squares fit may have been dragged by them. Robust (Cauchy)
       // refit from the start, then RANSAC over two-pair minimal solutions for a larger consensus.
@@ -236,8 +237,9 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
       bool conv = false;
       const double scale = std::max(deg2rad(o.inlier_min_deg), threshold / o.inlier_sigmas);
       result.iterations += refineRotation(pairs, gated, settings(scale), &X, &conv);
-      threshold = inlierThreshold(residualNorms(pairs, gated, X), o);
-      inliers = classify(X, threshold);
+      const std::vector<double> robust_norms = residualNorms(pairs, gated, X);
+      threshold = inlierThreshold(robust_norms, o);
+      inliers = select(robust_norms, threshold);
       std::vector<int> samples;
       for (int j : gated) {
         if (goodSample(pairs[j])) samples.push_back(j);
