@@ -26,6 +26,20 @@ TEST(RotationMath, ExpLogRoundTripOverAllAngles) {
   }
 }
 
+TEST(RotationMath, QuaternionLogEqualsMatrixLogForBothSigns) {
+  std::mt19937_64 rng(5);
+  for (double angle : {0.0, 1e-10, 1e-4, 0.05, 0.199, 0.2, 0.201, 1.0, 3.0, kPi - 1e-7}) {
+    for (int trial = 0; trial < 20; ++trial) {
+      const Eigen::Vector3d v = angle * test::randomUnitVector(rng);
+      const Eigen::Quaterniond q(
+          Eigen::AngleAxisd(angle, v.norm() > 0 ? v.normalized() : Eigen::Vector3d::UnitX()));
+      const Eigen::Quaterniond minus_q(-q.w(), -q.x(), -q.y(), -q.z());
+      EXPECT_LT((logQuaternion(q) - logSO3(q.toRotationMatrix())).norm(), 1e-12) << angle;
+      EXPECT_LT((logQuaternion(minus_q) - logQuaternion(q)).norm(), 1e-15) << angle;
+    }
+  }
+}
+
 TEST(RotationMath, LogAtExactlyPiGivesTheAxisUpToSign) {
   for (const Eigen::Vector3d& axis :
        {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, 0, 1),

@@ -19,6 +19,9 @@ Eigen::Matrix3d expSO3(const Eigen::Vector3d& rotvec);
 /// trace/acos formula loses the axis (the failure mode of OpenCV issues #17986 and #24871).
 Eigen::Vector3d logSO3(const Eigen::Matrix3d& R);
 
+/// Rotation vector of a unit quaternion (q and -q give the same); equals logSO3 of its matrix.
+Eigen::Vector3d logQuaternion(const Eigen::Quaterniond& q);
+
 /// Rotation angle of R in [0, pi] (rad), accurate near 0 and pi.
 double rotationAngle(const Eigen::Matrix3d& R);
 

@@ -1,6 +1,7 @@
 #include "camera_imu_alignment/alignment_solver.h"
 
 #include <cstdio>
+#include <utility>
 
 #include "camera_imu_alignment/closed_form_solver.h"
 #include "camera_imu_alignment/rotation_math.h"
@@ -47,15 +48,15 @@ AlignmentResult solveAlignment(const RotationPairs& pairs, const SolverOptions& 
     result.start = "identity";
     if (options.two_step.initial_R_cam_imu) result.start = "given";
   } else {
-    const OptimalResult opt = solveOptimal(pairs, options.optimal);
-    result.two_step = opt.two_step;
+    OptimalResult opt = solveOptimal(pairs, options.optimal);
+    result.two_step = std::move(opt.two_step);
     result.R_cam_imu = opt.R_cam_imu;
     result.iterations = opt.iterations;
     result.converged = opt.converged;
     result.start = opt.start;
-    inlier = opt.inlier;
-    rejection = opt.rejection;
-    residuals = opt.residuals;
+    inlier = std::move(opt.inlier);
+    rejection = std::move(opt.rejection);
+    residuals = std::move(opt.residuals);
   }
   if (!result.R_cam_imu.allFinite()) {
     result.R_cam_imu.setIdentity();

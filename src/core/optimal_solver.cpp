@@ -29,14 +29,36 @@ double robustLoss(double r2, double cauchy_scale) {
   return c2 * std::log1p(r2 / c2);
 }
 
+/// Each pair's A and B^-1 as unit quaternions, computed once per solve: a residual is then
+/// Log(q_A q_X q_B^-1 q_X^-1), three Hamilton products instead of three 3x3 products and a matrix
+/// logarithm (the same value as pairResidual).
+class PairQuaternions {
+ public:
+  explicit PairQuaternions(const RotationPairs& pairs) {
+    a_.reserve(pairs.size());
+    b_inv_.reserve(pairs.size());
+    for (const auto& p : pairs) {
+      a_.push_back(Eigen::Quaterniond(p.A_cam).normalized());
+      b_inv_.push_back(Eigen::Quaterniond(p.B_imu).normalized().conjugate());
+    }
+  }
+  Eigen::Vector3d residual(int j, const Eigen::Quaterniond& x) const {
+    return logQuaternion(a_[j] * x * b_inv_[j] * x.conjugate());
+  }
+
+ private:
+  std::vector<Eigen::Quaterniond> a_, b_inv_;
+};
+
 /// Residual vectors r_j at X for the pairs in idx; returns the total loss.
-double evaluateResiduals(const RotationPairs& pairs, const std::vector<int>& idx,
+double evaluateResiduals(const PairQuaternions& quats, const std::vector<int>& idx,
                          const Eigen::Matrix3d& X, double cauchy_scale,
                          std::vector<Eigen::Vector3d>* residuals) {
+  const Eigen::Quaterniond x(X);
   residuals->resize(idx.size());
   double cost = 0.0;
   for (size_t i = 0; i < idx.size(); ++i) {
-    (*residuals)[i] = pairResidual(pairs[idx[i]], X);
+    (*residuals)[i] = quats.residual(idx[i], x);
     cost += robustLoss((*residuals)[i].squaredNorm(), cauchy_scale);
   }
   return cost;
@@ -50,11 +72,12 @@ std::vector<double> normsOf(const std::vector<Eigen::Vector3d>& residuals, size_
   return norms;
 }
 
-std::vector<double> residualNorms(const RotationPairs& pairs, const std::vector<int>& idx,
+std::vector<double> residualNorms(const PairQuaternions& quats, const std::vector<int>& idx,
                                   const Eigen::Matrix3d& X) {
+  const Eigen::Quaterniond x(X);
   std::vector<double> r;
   r.reserve(idx.size());
-  for (int j : idx) r.push_back(pairResidual(pairs[j], X).norm());
+  for (int j : idx) r.push_back(quats.residual(j, x).norm());
   return r;
 }
 
@@ -82,9 +105,12 @@ bool goodSample(const RotationPair& p) {
 
 }  // namespace
 
-int refineRotation(const RotationPairs& pairs, const std::vector<int>& indices,
-                   const RefineSettings& settings, Eigen::Matrix3d* R_cam_imu, bool* converged,
-                   std::vector<Eigen::Vector3d>* residuals_io) {
+namespace {
+
+int refine(const RotationPairs& pairs, const PairQuaternions& quats,
+           const std::vector<int>& indices, const RefineSettings& settings,
+           Eigen::Matrix3d* R_cam_imu, bool* converged,
+           std::vector<Eigen::Vector3d>* residuals_io = nullptr) {
   *converged = false;
   Eigen::Matrix3d X = *R_cam_imu;
   const double scale = settings.cauchy_scale_rad;
@@ -95,7 +121,7 @@ int refineRotation(const RotationPairs& pairs, const std::vector<int>& indices,
   if (residuals.size() == indices.size()) {
     for (const auto& r : residuals) cost += robustLoss(r.squaredNorm(), scale);
   } else {
-    cost = evaluateResiduals(pairs, indices, X, scale, &residuals);
+    cost = evaluateResiduals(quats, indices, X, scale, &residuals);
   }
   const double c2 = scale * scale;
   const double dof = std::max(1.0, 3.0 * indices.size() - 3.0);
@@ -123,7 +149,7 @@ int refineRotation(const RotationPairs& pairs, const std::vector<int>& indices,
       const Eigen::Vector3d delta = -(H + lambda * Eigen::Matrix3d::Identity()).ldlt().solve(g);
       if (!delta.allFinite()) break;
       const Eigen::Matrix3d X_new = expSO3(delta) * X;
-      const double new_cost = evaluateResiduals(pairs, indices, X_new, scale, &trial_residuals);
+      const double new_cost = evaluateResiduals(quats, indices, X_new, scale, &trial_residuals);
       const bool small_step = delta.norm() < tolerance;
       if (new_cost <= cost || small_step) {
         accepted = true;
@@ -141,6 +167,14 @@ int refineRotation(const RotationPairs& pairs, const std::vector<int>& indices,
   }
   *R_cam_imu = X;
   return it;
+}
+
+}  // namespace
+
+int refineRotation(const RotationPairs& pairs, const std::vector<int>& indices,
+                   const RefineSettings& settings, Eigen::Matrix3d* R_cam_imu, bool* converged,
+                   std::vector<Eigen::Vector3d>* residuals) {
+  return refine(pairs, PairQuaternions(pairs), indices, settings, R_cam_imu, converged, residuals);
 }
 
 OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) {
@@ -185,7 +219,8 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
   Eigen::Matrix3d X = result.two_step.R_cam_imu_left;
   result.start = "two_step";
   std::vector<Eigen::Vector3d> start_residuals;
-  if (result.two_step.valid) evaluateResiduals(pairs, gated, X, 0.0, &start_residuals);
+  const PairQuaternions quats(pairs);
+  if (result.two_step.valid) evaluateResiduals(quats, gated, X, 0.0, &start_residuals);
   std::vector<double> start_norms = normsOf(start_residuals, gated.size());
   const double start_median = median(start_norms);
   std::vector<double> gated_angle_diff;
@@ -196,7 +231,7 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
       start_median > 4.0 * noise_proxy + 1e-9) {
     if (auto cf = solveClosedForm(pairs, gated)) {
       std::vector<Eigen::Vector3d> cf_residuals;
-      evaluateResiduals(pairs, gated, *cf, 0.0, &cf_residuals);
+      evaluateResiduals(quats, gated, *cf, 0.0, &cf_residuals);
       std::vector<double> cf_norms = normsOf(cf_residuals, gated.size());
       if (median(cf_norms) < start_median) {
         X = *cf;
@@ -213,7 +248,7 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
   //    would flag good pairs: the two-step's bias inflates some residuals).
   std::vector<Eigen::Vector3d> residuals = start_residuals;
   bool converged = false;
-  result.iterations += refineRotation(pairs, gated, settings(0.0), &X, &converged, &residuals);
+  result.iterations += refine(pairs, quats, gated, settings(0.0), &X, &converged, &residuals);
   std::vector<int> inliers = gated;
   if (o.reject_outliers && gated.size() > 2) {
     // Pairs of `gated` whose residual norm (same order) is within the threshold.
@@ -225,7 +260,7 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
       return in;
     };
     const auto classify = [&](const Eigen::Matrix3d& R, double threshold) {
-      return select(residualNorms(pairs, gated, R), threshold);
+      return select(residualNorms(quats, gated, R), threshold);
     };
     const std::vector<double> norms = normsOf(residuals, gated.size());
     double threshold = inlierThreshold(norms, o);
@@ -236,8 +271,8 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
       X = X_start;
       bool conv = false;
       const double scale = std::max(deg2rad(o.inlier_min_deg), threshold / o.inlier_sigmas);
-      result.iterations += refineRotation(pairs, gated, settings(scale), &X, &conv);
-      const std::vector<double> robust_norms = residualNorms(pairs, gated, X);
+      result.iterations += refine(pairs, quats, gated, settings(scale), &X, &conv);
+      const std::vector<double> robust_norms = residualNorms(quats, gated, X);
       threshold = inlierThreshold(robust_norms, o);
       inliers = select(robust_norms, threshold);
       std::vector<int> samples;
@@ -262,7 +297,7 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
           std::vector<int> in_h = classify(X_h, threshold);
           if (in_h.size() > inliers.size()) {
             bool c = false;
-            result.iterations += refineRotation(pairs, in_h, settings(0.0), &X_h, &c);
+            result.iterations += refine(pairs, quats, in_h, settings(0.0), &X_h, &c);
             std::vector<int> in_refined = classify(X_h, threshold);
             if (in_refined.size() > inliers.size()) {
               inliers = std::move(in_refined);
@@ -274,8 +309,7 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
       if (inliers.size() < 2) inliers = gated;  // never fit fewer pairs than the minimum
       // 4. Final least squares on the inliers.
       residuals.clear();
-      result.iterations +=
-          refineRotation(pairs, inliers, settings(0.0), &X, &converged, &residuals);
+      result.iterations += refine(pairs, quats, inliers, settings(0.0), &X, &converged, &residuals);
     }
   }
   result.converged = converged;

@@ -4,6 +4,20 @@
 #include <cmath>
 
 namespace camera_imu_alignment {
+namespace {
+
+/// asin(s) / s for 0 <= s < 0.1 (truncation below 2e-18 relative).
+double asinOverArgSeries(double s) {
+  const double s2 = s * s;
+  return 1.0 + s2 * (1.0 / 6.0 +
+                     s2 * (3.0 / 40.0 +
+                           s2 * (5.0 / 112.0 +
+                                 s2 * (35.0 / 1152.0 +
+                                       s2 * (63.0 / 2816.0 +
+                                             s2 * (231.0 / 13312.0 + s2 * (143.0 / 10240.0)))))));
+}
+
+}  // namespace
 
 Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
   Eigen::Matrix3d S;
@@ -26,17 +40,9 @@ Eigen::Vector3d logSO3(const Eigen::Matrix3d& R) {
   const double sin_angle = half_vee.norm();
   const double cos_angle = 0.5 * (R.trace() - 1.0);
   if (cos_angle > 0.0 && sin_angle < 0.1) {
-    // Small angles (the residuals of a good fit): theta / sin(theta) = asin(s) / s as a series,
-    // truncation below 2e-18 relative for s < 0.1; no transcendental call.
-    const double s2 = sin_angle * sin_angle;
-    const double ratio =
-        1.0 + s2 * (1.0 / 6.0 +
-                    s2 * (3.0 / 40.0 +
-                          s2 * (5.0 / 112.0 +
-                                s2 * (35.0 / 1152.0 +
-                                      s2 * (63.0 / 2816.0 +
-                                            s2 * (231.0 / 13312.0 + s2 * (143.0 / 10240.0)))))));
-    return half_vee * ratio;
+    // Small angles (the residuals of a good fit): theta / sin(theta) = asin(s) / s as a series;
+    // no transcendental call.
+    return half_vee * asinOverArgSeries(sin_angle);
   }
   if (cos_angle > -0.9) {
     // Away from pi the skew part carries the axis accurately.
@@ -48,6 +54,14 @@ Eigen::Vector3d logSO3(const Eigen::Matrix3d& R) {
   if (q.w() < 0.0) q.coeffs() = -q.coeffs();
   const double sin_half = q.vec().norm();
   return q.vec() * (2.0 * std::atan2(sin_half, q.w()) / sin_half);
+}
+
+Eigen::Vector3d logQuaternion(const Eigen::Quaterniond& q) {
+  const double sign = q.w() < 0.0 ? -1.0 : 1.0;  // q and -q: the same rotation
+  const Eigen::Vector3d v = sign * q.vec();
+  const double s = v.norm();  // sin(theta / 2)
+  if (s < 0.1) return v * (2.0 * asinOverArgSeries(s));
+  return v * (2.0 * std::atan2(s, sign * q.w()) / s);
 }
 
 double rotationAngle(const Eigen::Matrix3d& R) {

@@ -152,9 +152,8 @@ SolutionQuality evaluateQuality(const RotationPairs& pairs, const Eigen::Matrix3
         q.weakest_excitation_deg, needed_deg, others, axisName(q.excite_axis_cam).c_str());
   } else {
     q.observable = true;
-    std::snprintf(msg, sizeof(msg),
-                  "observable (observability %.3g, weakest excitation %.3g deg about camera %s)",
-                  q.observability, q.weakest_excitation_deg, axisName(q.weak_axis_cam).c_str());
+    // The numbers are in the fields; solveAlignment's message repeats the ones that matter.
+    std::snprintf(msg, sizeof(msg), "observable");
   }
   q.observability_message = msg;
   return q;
