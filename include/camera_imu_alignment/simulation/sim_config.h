@@ -1,0 +1,121 @@
+// Settings of the camera + inertial/magnetic unit simulator (simulate_bag) and its scenario
+// presets. Units: seconds, metres, radians (names ending in _deg: degrees), tesla for magnetic
+// fields, Hz. Frames (shared/CONVENTIONS.md): world is ENU with gravity (0, 0, -9.81); the camera
+// frame is optical (z forward, x right, y down); R_cam_imu maps IMU vectors into the camera frame.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace camera_imu_alignment {
+namespace simulation {
+
+/// How the rig moves between stationary poses.
+enum class MotionKind {
+  kFull,        ///< roll, pitch and yaw diversity with some translation: all axes excited
+  kSingleAxis,  ///< rotations about the optical axis only (degenerate: one axis unobservable)
+  kSmallAngle,  ///< full motion but within a few degrees (poorly conditioned)
+};
+
+enum class TargetType { kCheckerboard, kAprilgrid, kCirclegrid };
+
+/// Planar target in Kalibr's terms (shared/CONVENTIONS.md "Target description").
+struct TargetSpec {
+  TargetType type = TargetType::kCheckerboard;
+  int cols = 8;                  ///< checkerboard inner corners / aprilgrid tags / circles along x
+  int rows = 6;                  ///< same along y
+  double spacing_m = 0.04;       ///< checkerboard square, circle spacing, aprilgrid tagSize (m)
+  double tag_spacing = 0.3;      ///< aprilgrid: gap between tags as a fraction of tagSize
+  bool asymmetric_grid = false;  ///< circlegrid only
+};
+
+/// Kalibr imu.yaml noise terms (continuous time), before `noise_scale`.
+struct SensorNoise {
+  double accelerometer_noise_density = 1.86e-3;    ///< m/s^2/sqrt(Hz)
+  double accelerometer_random_walk = 4.33e-4;      ///< m/s^3/sqrt(Hz)
+  double gyroscope_noise_density = 1.87e-4;        ///< rad/s/sqrt(Hz)
+  double gyroscope_random_walk = 2.66e-5;          ///< rad/s^2/sqrt(Hz)
+  double gyroscope_initial_bias_sigma = 5e-3;      ///< rad/s, per axis, drawn once per seed
+  double accelerometer_initial_bias_sigma = 0.05;  ///< m/s^2, per axis, drawn once per seed
+  double magnetometer_noise_sigma = 0.3e-6;        ///< T per sample, per axis
+};
+
+struct SimulationConfig {
+  std::string scenario = "nominal";
+  std::uint64_t seed = 1;
+
+  // Motion.
+  int num_poses = 12;
+  double hold_min_s = 3.0, hold_max_s = 5.0;  ///< stationary time at each pose
+  double move_min_s = 2.0, move_max_s = 3.0;  ///< smooth motion between poses
+  MotionKind motion = MotionKind::kFull;
+  double max_tilt_deg = 35.0;                          ///< viewing direction off the target normal
+  double max_roll_deg = 80.0;                          ///< rotation about the optical axis
+  double min_distance_m = 0.55, max_distance_m = 0.9;  ///< camera to target centre
+
+  // Mounting. Random per seed (at least 30 deg from the identity) unless given.
+  bool given_R_cam_imu = false;
+  Eigen::Matrix3d R_cam_imu = Eigen::Matrix3d::Identity();
+
+  // Environment.
+  Eigen::Vector3d gravity_world{0.0, 0.0, -9.81};         ///< m/s^2, ENU
+  Eigen::Vector3d earth_field_world{0.0, 22e-6, -42e-6};  ///< T, ENU
+
+  // Inertial/magnetic unit.
+  double imu_rate_hz = 200.0;
+  double noise_scale = 1.0;  ///< multiplies every sensor noise (IMU, magnetometer, pixels)
+  SensorNoise imu_noise;
+  bool magnetometer = true;
+  double mag_rate_hz = 100.0;
+  Eigen::Vector3d mag_hard_iron{0.0, 0.0, 0.0};  ///< T, IMU frame, added to every sample
+  std::vector<int> mag_disturbance_poses;        ///< 0-based poses whose hold is disturbed
+  double mag_disturbance_t = 25e-6;              ///< T, magnitude of the extra (world) field
+
+  // Camera (pinhole + plumb_bob distortion k1, k2, p1, p2, k3).
+  int width = 640, height = 480;
+  double fx = 500.0, fy = 500.0, cx = 319.5, cy = 239.5;
+  std::array<double, 5> distortion{0.0, 0.0, 0.0, 0.0, 0.0};
+  /// 5 Hz by default, not 15: 640x480 mono8 at 15 Hz over the ~75 s nominal run would be a
+  /// ~380 MB bag; 5 Hz (~15-25 frames per hold) keeps it near 130 MB. --camera-rate-hz 15 works.
+  double camera_rate_hz = 5.0;
+  double camera_time_offset_s = 0.0;    ///< image stamp = true capture time + offset
+  double blur_sigma_px = 0.6;           ///< Gaussian optical blur
+  double pixel_noise_sigma = 1.5;       ///< grey levels (0-255), before noise_scale
+  int supersample = 3;                  ///< samples per pixel along each axis
+  double motion_blur_exposure_s = 0.0;  ///< > 0: frames in motion average renders over it
+  TargetSpec target;
+
+  // Remount: R_cam_imu becomes Exp(remount_rotvec_cam) * R_cam_imu over 1 s centred on the time.
+  bool remount = false;
+  double remount_time_s = -1.0;  ///< since the start; < 0: middle of the central motion
+  Eigen::Vector3d remount_rotvec_cam{0.0, 10.0 * 3.14159265358979323846 / 180.0,
+                                     0.0};  ///< rad, camera frame
+
+  bool bad_input = false;  ///< inject NaNs, duplicate/out-of-order stamps, bad images/info
+
+  // ROS names and time base (used by the tool only).
+  std::string imu_topic = "imu/data_raw", mag_topic = "imu/mag";
+  std::string image_topic = "camera/image_raw", camera_info_topic = "camera/camera_info";
+  std::string imu_frame = "imu_link", camera_frame = "camera_optical_frame";
+  double start_time_s = 1700000000.0;  ///< bag time of the simulation's t = 0
+};
+
+/// Scenario names with a one-line description each, in --help order.
+const std::vector<std::pair<std::string, std::string>>& scenarioList();
+
+/// Resets `config` to the defaults and applies the preset `name` (seed kept). Returns false for an
+/// unknown name.
+bool applyScenario(const std::string& name, SimulationConfig* config);
+
+/// Checks every setting; returns an empty string when usable, else a message naming the setting.
+std::string validateConfig(const SimulationConfig& config);
+
+const char* targetTypeName(TargetType type);
+const char* motionKindName(MotionKind kind);
+
+}  // namespace simulation
+}  // namespace camera_imu_alignment

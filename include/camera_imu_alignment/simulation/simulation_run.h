@@ -1,0 +1,52 @@
+// One complete simulated run: trajectory, inertial/magnetic samples, camera frame times and the
+// bad-input plan, all determined by the configuration (seed included). Times are seconds since the
+// start of the run (bag time = config.start_time_s + t). Rendering is done per frame by the caller
+// (ImageRenderer), so a run costs little memory.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "camera_imu_alignment/simulation/inertial_model.h"
+#include "camera_imu_alignment/simulation/sim_config.h"
+#include "camera_imu_alignment/simulation/trajectory.h"
+
+namespace camera_imu_alignment {
+namespace simulation {
+
+/// Bad-input injections (indices into the run's sample/frame vectors), sorted.
+struct BadInputPlan {
+  std::vector<long> nan_imu;                ///< IMU samples sent with NaN gyro and accelerometer
+  std::vector<long> duplicate_imu;          ///< IMU samples sent twice with the same stamp
+  std::vector<long> out_of_order_imu;       ///< i: samples i and i + 1 sent with swapped stamps
+  std::vector<long> nan_mag;                ///< magnetometer samples sent as NaN
+  std::vector<long> empty_images;           ///< frames sent as a 0 x 0 image (no data)
+  std::vector<long> wrong_encoding_images;  ///< frames sent as "rgb8" with 3 bytes per pixel
+  std::vector<long> zero_k_camera_infos;    ///< frames whose CameraInfo has K (and P) all zero
+  bool empty() const {
+    return nan_imu.empty() && duplicate_imu.empty() && out_of_order_imu.empty() &&
+           nan_mag.empty() && empty_images.empty() && wrong_encoding_images.empty() &&
+           zero_k_camera_infos.empty();
+  }
+};
+
+struct SimulationRun {
+  SimulationConfig config;
+  Trajectory trajectory;
+  std::vector<InertialSample> imu;
+  std::vector<MagSample> mag;
+  std::vector<MagDisturbance> disturbances;
+  std::vector<double> frame_times;  ///< true capture times (s); stamps add camera_time_offset_s
+  BadInputPlan bad_input;
+
+  explicit SimulationRun(const SimulationConfig& c);
+  /// Image noise seed of frame j (independent of every other random stream).
+  std::uint64_t frameNoiseSeed(long j) const;
+};
+
+/// The truth YAML (R_cam_imu in the result format of shared/CONVENTIONS.md, stationary intervals
+/// in bag time, per-pose orientations, noise settings, seed, scenario, injections).
+std::string truthYaml(const SimulationRun& run);
+
+}  // namespace simulation
+}  // namespace camera_imu_alignment
