@@ -1,9 +1,14 @@
 // CSV readers/writers and the result YAML: formats of CONVENTIONS.md, errors naming file and line.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
-#include <cstdio>
+#include <cctype>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "camera_imu_alignment/csv_io.h"
 #include "camera_imu_alignment/result_yaml.h"
@@ -13,91 +18,217 @@
 namespace camera_imu_alignment {
 namespace {
 
+/// A directory of this process alone (other workspaces may run the same test at the same time),
+/// removed at exit.
+const std::string& tempDir() {
+  struct TempDir {
+    std::string path;
+    TempDir() {
+      std::string pattern = ::testing::TempDir() + "cia_csv_XXXXXX";
+      if (!mkdtemp(&pattern[0])) std::abort();
+      path = pattern + "/";
+    }
+    ~TempDir() {
+      std::error_code ignored;
+      std::filesystem::remove_all(path, ignored);
+    }
+  };
+  static const TempDir dir;
+  return dir.path;
+}
+
 std::string writeTemp(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + "cia_" + name;
-  std::ofstream(path) << text;
+  const std::string path = tempDir() + name;
+  std::ofstream(path, std::ios::binary) << text;
   return path;
 }
 
-/// Expects readPairsCsv to throw an InputError whose message contains all of `parts`.
-void expectPairsError(const std::string& path, const std::vector<std::string>& parts) {
+const Eigen::Vector3d kX = Eigen::Vector3d::UnitX(), kY = Eigen::Vector3d::UnitY(),
+                      kZ = Eigen::Vector3d::UnitZ();
+
+/// True when `msg` contains "path:<digit>".
+bool namesALine(const std::string& msg, const std::string& path) {
+  for (auto at = msg.find(path + ":"); at != std::string::npos; at = msg.find(path + ":", at + 1)) {
+    const size_t next = at + path.size() + 1;
+    if (next < msg.size() && std::isdigit(static_cast<unsigned char>(msg[next]))) return true;
+  }
+  return false;
+}
+
+/// Runs `read` (expected to throw InputError) and checks the message: it contains `path`, and
+/// "path:line" when `line` > 0 (any "path:<number>" when line == 0; line unchecked when < 0), and
+/// every string of `parts`.
+template <typename Read>
+void expectError(Read read, const std::string& path, int line,
+                 const std::vector<std::string>& parts = {}) {
   try {
-    readPairsCsv(path);
-    ADD_FAILURE() << "no error for " << path;
+    read(path);
+    ADD_FAILURE() << "no InputError for " << path;
   } catch (const InputError& e) {
     const std::string msg = e.what();
+    EXPECT_NE(msg.find(path), std::string::npos) << "'" << msg << "' does not name " << path;
+    if (line > 0) {
+      EXPECT_NE(msg.find(path + ":" + std::to_string(line)), std::string::npos)
+          << "'" << msg << "' does not name line " << line;
+    } else if (line == 0) {
+      EXPECT_TRUE(namesALine(msg, path)) << "'" << msg << "' names no line of " << path;
+    }
     for (const auto& part : parts)
-      EXPECT_NE(msg.find(part), std::string::npos) << msg << " lacks " << part;
+      EXPECT_NE(msg.find(part), std::string::npos) << "'" << msg << "' lacks '" << part << "'";
   }
 }
 
-const char* kHeader = "qa_w,qa_x,qa_y,qa_z,qb_w,qb_x,qb_y,qb_z\n";
+const auto readPairs = [](const std::string& p) { return readPairsCsv(p); };
+const auto readPoses = [](const std::string& p) { return readPosesCsv(p); };
 
-TEST(CsvIo, ReadsColumnsByNameInAnyOrder) {
-  const std::string path =
-      writeTemp("order.csv",
-                "# a comment\n\nnote,qb_x,qb_y,qb_z,qb_w,qa_w,qa_x,qa_y,qa_z\r\n"
-                "first,0,0,0.70710678,0.70710678,1,0,0,0\r\n"
-                "second,0,0,0,-1,0,1,0,0\r\n");
-  const RotationPairs pairs = readPairsCsv(path);
+const std::string kPairsHeader = "qa_w,qa_x,qa_y,qa_z,qb_w,qb_x,qb_y,qb_z\n";
+const std::string kPosesHeader = "stamp,cam_qw,cam_qx,cam_qy,cam_qz,imu_qw,imu_qx,imu_qy,imu_qz\n";
+
+TEST(CsvIo, PairsColumnsInAnyOrderWithCrlfCommentsAndExtraColumns) {
+  const double h = std::sqrt(0.5);
+  std::ostringstream text;
+  text.precision(17);
+  text << "# a comment\r\n\r\n  \nnote,qb_x,qb_y,qb_z,qb_w,qa_w,extra,qa_x,qa_y,qa_z\r\n"
+       << "first,0,0," << h << "," << h << ",1,99,0,0,0\r\n"
+       << "# a comment between rows, then a blank line\r\n\r\n"
+       << "second,0,0,0,-1,0,-5,1,0,0\r\n";
+  const RotationPairs pairs = readPairsCsv(writeTemp("order.csv", text.str()));
   ASSERT_EQ(pairs.size(), 2u);
-  EXPECT_LT((pairs[0].A_cam - Eigen::Matrix3d::Identity()).norm(), 1e-12);
-  EXPECT_LT((pairs[0].B_imu - test::axisAngle(Eigen::Vector3d::UnitZ(), test::kPiTest / 2)).norm(),
-            1e-7);
-  EXPECT_LT((pairs[1].B_imu - Eigen::Matrix3d::Identity()).norm(),
-            1e-12);  // q = -1 is the identity
-  EXPECT_LT((pairs[1].A_cam - test::axisAngle(Eigen::Vector3d::UnitX(), test::kPiTest)).norm(),
-            1e-12);
-  EXPECT_EQ(pairs[0].pose_k, -1);
+  EXPECT_ROTATION_NEAR_DEG(pairs[0].A_cam, Eigen::Matrix3d::Identity(), 1e-12);
+  EXPECT_ROTATION_NEAR_DEG(pairs[0].B_imu, test::axisAngle(kZ, test::kPiTest / 2), 1e-12);
+  EXPECT_ROTATION_NEAR_DEG(pairs[1].B_imu, Eigen::Matrix3d::Identity(), 1e-12);  // q = -1
+  EXPECT_ROTATION_NEAR_DEG(pairs[1].A_cam, test::axisAngle(kX, test::kPiTest), 1e-12);
+  for (const auto& p : pairs) {
+    EXPECT_EQ(p.pose_k, -1);  // independent pairs
+    EXPECT_EQ(p.pose_t, -1);
+  }
+}
+
+TEST(CsvIo, PosesColumnsInAnyOrderWithCrlfCommentsAndExtraColumns) {
+  // Pose 0: camera 90 deg about y, IMU 90 deg about x; pose 1: camera identity, IMU 180 about z.
+  const double h = std::sqrt(0.5);
+  std::ostringstream text;
+  text.precision(17);
+  text << "# poses\r\nimu_qz,imu_qy,imu_qx,imu_qw,frame,cam_qz,cam_qy,cam_qx,cam_qw,stamp\r\n"
+       << "0,0," << h << "," << h << ",17,0," << h << ",0," << h << ",12.25\r\n\r\n"
+       << "1,0,0,0,18,0,0,0,-1,13.5\r\n";
+  const auto poses = readPosesCsv(writeTemp("poses_order.csv", text.str()));
+  ASSERT_EQ(poses.size(), 2u);
+  EXPECT_EQ(poses[0].stamp_s, 12.25);
+  EXPECT_EQ(poses[1].stamp_s, 13.5);
+  EXPECT_ROTATION_NEAR_DEG(poses[0].R_target_cam, test::axisAngle(kY, test::kPiTest / 2), 1e-12);
+  EXPECT_ROTATION_NEAR_DEG(poses[0].R_world_imu, test::axisAngle(kX, test::kPiTest / 2), 1e-12);
+  EXPECT_ROTATION_NEAR_DEG(poses[1].R_target_cam, Eigen::Matrix3d::Identity(), 1e-12);
+  EXPECT_ROTATION_NEAR_DEG(poses[1].R_world_imu, test::axisAngle(kZ, test::kPiTest), 1e-12);
 }
 
 TEST(CsvIo, NormalisesNearlyUnitQuaternionsAndTreatsQAndMinusQAlike) {
-  const std::string path = writeTemp("norm.csv", std::string(kHeader) +
-                                                     "1.001,0,0,0,0.5,0.5,0.5,0.5\n"
-                                                     "-1.001,0,0,0,-0.5,-0.5,-0.5,-0.5\n");
+  // (0.5, 0.5, 0.5, 0.5) is 120 deg about (1, 1, 1); scaled by 1.001 it must read as the same.
+  const Eigen::Matrix3d R120 = test::axisAngle(Eigen::Vector3d(1, 1, 1), 2 * test::kPiTest / 3);
+  const std::string path = writeTemp("norm.csv", kPairsHeader +
+                                                     "1.001,0,0,0,0.5005,0.5005,0.5005,0.5005\n"
+                                                     "-1.001,0,0,0,-0.5,-0.5,-0.5,-0.5\n"
+                                                     "0.999,0,0,0,0.4995,0.4995,0.4995,0.4995\n");
   const RotationPairs pairs = readPairsCsv(path);
-  EXPECT_TRUE(isRotationMatrix(pairs[0].A_cam, 1e-12));
-  EXPECT_LT((pairs[0].A_cam - pairs[1].A_cam).norm(), 1e-12);
-  EXPECT_LT((pairs[0].B_imu - pairs[1].B_imu).norm(), 1e-12);
+  ASSERT_EQ(pairs.size(), 3u);
+  for (const auto& p : pairs) {
+    EXPECT_TRUE(isRotationMatrix(p.A_cam, 1e-14));
+    EXPECT_TRUE(isRotationMatrix(p.B_imu, 1e-14));
+    EXPECT_LT((p.A_cam - Eigen::Matrix3d::Identity()).norm(), 1e-14);
+    EXPECT_LT((p.B_imu - R120).norm(), 1e-14);
+  }
+  // The documented tolerance: accepted just inside, rejected just outside.
+  const double inside = 1.0 + 0.5 * kQuaternionNormTolerance;
+  const double outside = 1.0 + 2.0 * kQuaternionNormTolerance;
+  EXPECT_NO_THROW(readPairsCsv(
+      writeTemp("inside.csv", kPairsHeader + std::to_string(inside) + ",0,0,0,1,0,0,0\n")));
+  expectError(
+      readPairs,
+      writeTemp("outside.csv", kPairsHeader + "1,0,0,0," + std::to_string(outside) + ",0,0,0\n"), 2,
+      {"norm"});
 }
 
-TEST(CsvIo, BadInputNamesFileAndLine) {
-  expectPairsError("/nonexistent/pairs.csv", {"/nonexistent/pairs.csv", "cannot open"});
-  expectPairsError(writeTemp("empty.csv", ""), {"empty.csv", "empty"});
-  expectPairsError(writeTemp("header_only.csv", kHeader), {"header_only.csv", "no data rows"});
-  expectPairsError(
-      writeTemp("bad_header.csv", "qa_w,qa_x,qa_y,qb_w,qb_x,qb_y,qb_z\n1,0,0,1,0,0,0\n"),
-      {"bad_header.csv:1", "qa_z"});
-  expectPairsError(
-      writeTemp("text.csv", std::string(kHeader) + "1,0,0,0,1,0,0,0\n1,0,zero,0,1,0,0,0\n"),
-      {"text.csv:3", "qa_y", "not a number"});
-  expectPairsError(writeTemp("nan.csv", std::string(kHeader) + "1,0,0,0,nan,0,0,0\n"),
-                   {"nan.csv:2", "not finite"});
-  expectPairsError(writeTemp("inf.csv", std::string(kHeader) + "1,0,0,0,1,inf,0,0\n"),
-                   {"inf.csv:2", "not finite"});
-  expectPairsError(writeTemp("short.csv", std::string(kHeader) + "1,0,0,0,1,0\n"),
-                   {"short.csv:2", "missing value"});
-  expectPairsError(writeTemp("big.csv", std::string(kHeader) + "1.5,0,0,0,1,0,0,0\n"),
-                   {"big.csv:2", "norm"});
-  expectPairsError(writeTemp("zero.csv", std::string(kHeader) + "1,0,0,0,0,0,0,0\n"),
-                   {"zero.csv:2", "norm"});
+TEST(CsvIo, PairsInputErrorsNameFileAndLine) {
+  expectError(readPairs, "/nonexistent_dir/pairs.csv", -1);
+  expectError(readPairs, writeTemp("empty.csv", ""), -1, {"empty"});  // 0 bytes: no line
+  expectError(readPairs,
+              writeTemp("bad_header.csv", "qa_w,qa_x,qa_y,qb_w,qb_x,qb_y,qb_z\n1,0,0,1,0,0,0\n"), 1,
+              {"qa_z"});
+  // Line numbers count every physical line, comments and blank lines included.
+  const std::string lead = "# truth ...\n\n" + kPairsHeader + "1,0,0,0,1,0,0,0\n";  // rows at 4..
+  expectError(readPairs, writeTemp("text.csv", lead + "1,0,zero,0,1,0,0,0\n"), 5, {"qa_y", "zero"});
+  expectError(readPairs, writeTemp("half.csv", lead + "1,0,0,0,1,0.5x,0,0\n"), 5, {"qb_x"});
+  expectError(readPairs, writeTemp("nan.csv", lead + "\n1,0,0,0,nan,0,0,0\n"), 6, {"qb_w"});
+  expectError(readPairs, writeTemp("inf.csv", lead + "1,0,0,0,1,inf,0,0\n"), 5, {"qb_x"});
+  expectError(readPairs, writeTemp("minf.csv", lead + "1,-inf,0,0,1,0,0,0\n"), 5, {"qa_x"});
+  expectError(readPairs, writeTemp("huge.csv", lead + "1,0,0,0,1,1e999,0,0\n"), 5, {"qb_x"});
+  expectError(readPairs, writeTemp("short.csv", lead + "1,0,0,0,1,0,0\n"), 5, {"qb_z"});
+  expectError(readPairs, writeTemp("very_short.csv", lead + "1,0\n"), 5, {"missing"});
+  expectError(readPairs, writeTemp("empty_cell.csv", lead + "1,0,,0,1,0,0,0\n"), 5, {"qa_y"});
+  expectError(readPairs, writeTemp("big.csv", lead + "1.5,0,0,0,1,0,0,0\n"), 5, {"norm"});
+  expectError(readPairs, writeTemp("zero.csv", lead + "1,0,0,0,0,0,0,0\n"), 5, {"norm"});
+  expectError(readPairs,
+              writeTemp("crlf_bad.csv",
+                        "qa_w,qa_x,qa_y,qa_z,qb_w,qb_x,qb_y,qb_z\r\n"
+                        "1,0,0,0,1,0,0,0\r\n1,0,0,0,2,0,0,0\r\n"),
+              3, {"norm"});
+  // A poses file given as pairs: the missing columns are named.
+  expectError(readPairs, writeTemp("poses_as_pairs.csv", kPosesHeader + "0,1,0,0,0,1,0,0,0\n"), 1,
+              {"qa_w"});
+}
+
+TEST(CsvIo, FilesWithoutDataRowsNameTheLine) {
+  // csv_io.h: "Every problem is reported as an InputError naming the file and the line". A file
+  // with lines but no data row has a line to name (the header, or the last line read).
+  expectError(readPairs, writeTemp("comments_only.csv", "# nothing\n\n# here\n"), 0);
+  expectError(readPairs, writeTemp("header_only.csv", kPairsHeader), 0, {"no data rows"});
+  expectError(readPairs, writeTemp("header_blank.csv", kPairsHeader + "\n# c\n\n"), 0);
+  expectError(readPoses, writeTemp("poses_header_only.csv", kPosesHeader), 0);
+}
+
+TEST(CsvIo, TinyFiniteValuesAreNotErrors) {
+  // 1e-320 is finite (subnormal); strtod flags its underflow with ERANGE, which is no input error.
+  const std::string path =
+      writeTemp("tiny.csv", kPairsHeader + "1,1e-320,0,0,1,0,-2.5e-310,0\n1,1e-300,0,0,1,0,0,0\n");
+  RotationPairs pairs;
+  try {
+    pairs = readPairsCsv(path);
+  } catch (const InputError& e) {
+    FAIL() << e.what();
+  }
+  ASSERT_EQ(pairs.size(), 2u);
+  EXPECT_ROTATION_NEAR_DEG(pairs[0].A_cam, Eigen::Matrix3d::Identity(), 1e-12);
+}
+
+TEST(CsvIo, PosesInputErrorsNameFileAndLine) {
+  expectError(readPoses, "/nonexistent_dir/poses.csv", -1);
+  expectError(readPoses, writeTemp("poses_empty.csv", ""), -1);
+  expectError(readPoses, writeTemp("poses_no_stamp.csv", kPairsHeader + "1,0,0,0,1,0,0,0\n"), 1,
+              {"stamp"});
+  const std::string lead = "# c\n" + kPosesHeader + "0,1,0,0,0,1,0,0,0\n";  // rows at 3..
+  expectError(readPoses, writeTemp("poses_stamp.csv", lead + "t1,1,0,0,0,1,0,0,0\n"), 4, {"stamp"});
+  expectError(readPoses, writeTemp("poses_nan.csv", lead + "nan,1,0,0,0,1,0,0,0\n"), 4, {"stamp"});
+  expectError(readPoses, writeTemp("poses_norm.csv", lead + "1,1,0,0,0,0.5,0,0,0\n"), 4, {"norm"});
+  expectError(readPoses, writeTemp("poses_short.csv", lead + "1,1,0,0,0,1,0,0\n"), 4, {"imu_qz"});
 }
 
 TEST(CsvIo, PairsAndPosesRoundTrip) {
   std::mt19937_64 rng(51);
-  RotationPairs pairs(5);
-  std::vector<PoseOrientation> poses(4);
+  RotationPairs pairs(20);
+  std::vector<PoseOrientation> poses(12);
   for (auto& p : pairs) {
     p.A_cam = test::randomRotation(rng);
     p.B_imu = test::randomRotation(rng);
   }
+  pairs[0].A_cam = test::axisAngle(kZ, test::kPiTest);  // w = 0 exactly
+  pairs[1].B_imu = Eigen::Matrix3d::Identity();
   for (size_t k = 0; k < poses.size(); ++k) {
-    poses[k].stamp_s = 1.5 * k;
+    poses[k].stamp_s = 1.7e9 + 0.1 * k;  // Unix-time stamps keep sub-millisecond digits
     poses[k].R_target_cam = test::randomRotation(rng);
     poses[k].R_world_imu = test::randomRotation(rng);
   }
-  const std::string pairs_path = ::testing::TempDir() + "cia_roundtrip_pairs.csv";
-  const std::string poses_path = ::testing::TempDir() + "cia_roundtrip_poses.csv";
+  const std::string pairs_path = tempDir() + "roundtrip_pairs.csv";
+  const std::string poses_path = tempDir() + "roundtrip_poses.csv";
   writePairsCsv(pairs_path, pairs);
   writePosesCsv(poses_path, poses);
   const RotationPairs pairs_back = readPairsCsv(pairs_path);
@@ -113,27 +244,39 @@ TEST(CsvIo, PairsAndPosesRoundTrip) {
     EXPECT_LT((poses_back[k].R_target_cam - poses[k].R_target_cam).norm(), 1e-14);
     EXPECT_LT((poses_back[k].R_world_imu - poses[k].R_world_imu).norm(), 1e-14);
   }
+  EXPECT_THROW(writePairsCsv("/nonexistent_dir/p.csv", pairs), InputError);
+  EXPECT_THROW(writePosesCsv("/nonexistent_dir/p.csv", poses), InputError);
 }
 
-AlignmentResult solvedExample(const Eigen::Matrix3d& X) {
-  std::mt19937_64 rng(52);
-  RotationPairs pairs;
-  for (int j = 0; j < 10; ++j) pairs.push_back(test::exactPair(X, test::randomRotation(rng)));
-  return solveAlignment(pairs);
+// ------------------------------------------------------------------------------------------------
+// Result YAML
+// ------------------------------------------------------------------------------------------------
+
+/// A result with known values (no solver involved), as in CONVENTIONS.md's example.
+AlignmentResult knownResult(const Eigen::Matrix3d& R) {
+  AlignmentResult r;
+  r.status = SolveStatus::kOk;
+  r.R_cam_imu = R;
+  r.iterations = 9;
+  r.quality.observable = true;
+  r.quality.num_pairs = 66;
+  r.quality.num_inliers = 64;
+  r.quality.residual_rms_deg = 0.21;
+  r.quality.std_dev_deg = Eigen::Vector3d(0.03, 0.04, 0.05);
+  return r;
 }
 
-TEST(ResultYaml, HasEveryKeyOfTheConventionsInTheRightOrder) {
-  const Eigen::Matrix3d X = test::axisAngle(Eigen::Vector3d::UnitZ(), test::kPiTest / 2);
-  const AlignmentResult r = solvedExample(X);
+TEST(ResultYaml, HasEveryKeyOfTheConventions) {
+  const Eigen::Matrix3d X = test::axisAngle(kZ, test::kPiTest / 2);  // 90 deg about z
   ResultMetadata meta;
-  meta.camera_frame = "cam0_optical";
-  meta.imu_frame = "imu0";
-  meta.num_poses = 0;
-  const YAML::Node y = YAML::Load(resultToYaml(r, meta));
-  EXPECT_EQ(y["camera_frame"].as<std::string>(), "cam0_optical");
-  EXPECT_EQ(y["imu_frame"].as<std::string>(), "imu0");
+  meta.camera_frame = "cam: #0 \"left\" \\ [x]";  // YAML syntax in names must survive
+  meta.imu_frame = "- imu, {a}";
+  meta.num_poses = 12;
+  const YAML::Node y = YAML::Load(resultToYaml(knownResult(X), meta));
+  EXPECT_EQ(y["camera_frame"].as<std::string>(), meta.camera_frame);
+  EXPECT_EQ(y["imu_frame"].as<std::string>(), meta.imu_frame);
   const auto q = y["R_cam_imu"]["quaternion_xyzw"].as<std::vector<double>>();
-  ASSERT_EQ(q.size(), 4u);  // x, y, z, w: 90 deg about z
+  ASSERT_EQ(q.size(), 4u);  // x, y, z, w: [0, 0, 0.7071, 0.7071]
   EXPECT_NEAR(q[0], 0.0, 1e-9);
   EXPECT_NEAR(q[1], 0.0, 1e-9);
   EXPECT_NEAR(q[2], std::sqrt(0.5), 1e-9);
@@ -145,56 +288,134 @@ TEST(ResultYaml, HasEveryKeyOfTheConventionsInTheRightOrder) {
   for (int i = 0; i < 3; ++i) {
     ASSERT_EQ(m[i].size(), 3u);
     ASSERT_EQ(T[i].size(), 4u);
-    EXPECT_EQ(T[i][3], 0.0);
+    EXPECT_EQ(T[i][3], 0.0);  // zero translation
     for (int k = 0; k < 3; ++k) {
-      EXPECT_NEAR(m[i][k], X(i, k), 1e-8);
-      EXPECT_EQ(T[i][k], m[i][k]);
+      EXPECT_NEAR(m[i][k], X(i, k), 1e-9);
+      EXPECT_NEAR(T[i][k], X(i, k), 1e-9);
     }
   }
   EXPECT_EQ(T[3], (std::vector<double>{0, 0, 0, 1}));
   const YAML::Node quality = y["quality"];
+  ASSERT_TRUE(quality.IsMap());
   EXPECT_TRUE(quality["observable"].as<bool>());
-  EXPECT_EQ(quality["num_poses"].as<int>(), 0);
-  EXPECT_EQ(quality["num_pairs"].as<int>(), 10);
-  EXPECT_EQ(quality["num_inliers"].as<int>(), 10);
-  EXPECT_GE(quality["residual_rms_deg"].as<double>(), 0.0);
-  EXPECT_EQ(quality["std_dev_deg"].as<std::vector<double>>().size(), 3u);
-  EXPECT_GE(quality["iterations"].as<int>(), 1);
-  const auto inverse = y["R_imu_cam"]["matrix"].as<std::vector<std::vector<double>>>();
-  EXPECT_NEAR(inverse[0][1], X(1, 0), 1e-8);
+  EXPECT_EQ(quality["num_poses"].as<int>(), 12);
+  EXPECT_EQ(quality["num_pairs"].as<int>(), 66);
+  EXPECT_EQ(quality["num_inliers"].as<int>(), 64);
+  EXPECT_NEAR(quality["residual_rms_deg"].as<double>(), 0.21, 1e-9);
+  EXPECT_EQ(quality["std_dev_deg"].as<std::vector<double>>(),
+            (std::vector<double>{0.03, 0.04, 0.05}));
+  EXPECT_EQ(quality["iterations"].as<int>(), 9);
+  AlignmentResult unobservable = knownResult(X);
+  unobservable.quality.observable = false;
+  EXPECT_FALSE(YAML::Load(resultToYaml(unobservable, meta))["quality"]["observable"].as<bool>());
 }
 
-TEST(ResultYaml, WritesAtomicallyAndReadsBack) {
-  std::mt19937_64 rng(53);
-  const Eigen::Matrix3d X = test::randomRotation(rng);
-  const std::string path = ::testing::TempDir() + "cia_result.yaml";
-  writeResultYaml(path, solvedExample(X), ResultMetadata{});
-  const StoredCalibration back = readResultYaml(path);
-  EXPECT_LT(test::angleBetweenDeg(back.R_cam_imu, X), 1e-9);
-  EXPECT_EQ(back.camera_frame, "camera_optical_frame");
-  EXPECT_THROW(writeResultYaml("/nonexistent_dir/result.yaml", solvedExample(X), ResultMetadata{}),
-               InputError);
-  // A failed write leaves no temporary file and the previous file intact.
-  EXPECT_FALSE(std::ifstream(path + ".tmp").good());
-  EXPECT_LT(test::angleBetweenDeg(readResultYaml(path).R_cam_imu, X), 1e-9);
-}
-
-TEST(ResultYaml, ReaderErrorsNameTheFile) {
-  const auto expectError = [](const std::string& path, const std::string& part) {
-    try {
-      readResultYaml(path);
-      ADD_FAILURE() << "no error for " << path;
-    } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+TEST(ResultYaml, QuaternionAndMatricesDescribeTheSameRotation) {
+  std::mt19937_64 rng(54);
+  for (int trial = 0; trial < 50; ++trial) {
+    const Eigen::Matrix3d X = test::randomRotation(rng);
+    const YAML::Node y = YAML::Load(resultToYaml(knownResult(X), ResultMetadata{}));
+    const auto q = y["R_cam_imu"]["quaternion_xyzw"].as<std::vector<double>>();
+    ASSERT_EQ(q.size(), 4u);
+    EXPECT_NEAR(std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]), 1.0, 1e-11);
+    EXPECT_ROTATION_NEAR_DEG(Eigen::Quaterniond(q[3], q[0], q[1], q[2]).toRotationMatrix(), X,
+                             1e-9);
+    const auto m = y["R_cam_imu"]["matrix"].as<std::vector<std::vector<double>>>();
+    const auto T = y["T_cam_imu"].as<std::vector<std::vector<double>>>();
+    for (int i = 0; i < 3; ++i) {
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_NEAR(m[i][k], X(i, k), 1e-8);
+        EXPECT_NEAR(T[i][k], X(i, k), 1e-8);
+      }
     }
+  }
+}
+
+TEST(ResultYaml, WriteThenReadRoundTrips) {
+  std::mt19937_64 rng(53);
+  for (int trial = 0; trial < 20; ++trial) {
+    const Eigen::Matrix3d X = test::randomRotation(rng);
+    ResultMetadata meta;
+    meta.camera_frame = "cam" + std::to_string(trial);
+    meta.imu_frame = "imu_link";
+    const std::string path = tempDir() + "result.yaml";
+    writeResultYaml(path, knownResult(X), meta);  // overwrites the previous trial's file
+    const StoredCalibration back = readResultYaml(path);
+    EXPECT_ROTATION_NEAR_DEG(back.R_cam_imu, X, 1e-9);
+    EXPECT_EQ(back.camera_frame, meta.camera_frame);
+    EXPECT_EQ(back.imu_frame, "imu_link");
+  }
+  // Only the matrix (9 digits): read through it.
+  const Eigen::Matrix3d X = test::randomRotation(rng);
+  std::ostringstream text;
+  text.precision(17);
+  text << "R_cam_imu:\n  matrix: [";
+  for (int i = 0; i < 3; ++i)
+    text << (i ? ", " : "") << "[" << X(i, 0) << ", " << X(i, 1) << ", " << X(i, 2) << "]";
+  text << "]\n";
+  EXPECT_ROTATION_NEAR_DEG(readResultYaml(writeTemp("matrix_only.yaml", text.str())).R_cam_imu, X,
+                           1e-9);
+}
+
+TEST(ResultYaml, FailedWritesThrowAndLeaveNoTrace) {
+  const AlignmentResult r = knownResult(Eigen::Matrix3d::Identity());
+  expectError([&](const std::string& p) { writeResultYaml(p, r, ResultMetadata{}); },
+              "/nonexistent_dir/x.yaml", -1);
+  // The target is a directory: the write fails; the directory stays and no temporary file is left.
+  const std::string dir_target = tempDir() + "a_directory";
+  std::filesystem::create_directory(dir_target);  // may exist from a repeated run
+  ASSERT_TRUE(std::filesystem::is_directory(dir_target));
+  const auto entries = [] {
+    return std::distance(std::filesystem::directory_iterator(tempDir()),
+                         std::filesystem::directory_iterator());
   };
-  expectError("/nonexistent/result.yaml", "/nonexistent/result.yaml");
-  expectError(writeTemp("invalid.yaml", "R_cam_imu: [unclosed\n"), "invalid.yaml");
-  expectError(writeTemp("nokey.yaml", "camera_frame: c\n"), "no R_cam_imu");
-  expectError(writeTemp("badq.yaml", "R_cam_imu:\n  quaternion_xyzw: [0, 0, 0, 2]\n"),
-              "unit quaternion");
-  expectError(writeTemp("badm.yaml", "R_cam_imu:\n  matrix: [[1, 0, 0], [0, 1, 0], [0, 0, 2]]\n"),
-              "rotation");
+  const auto entries_before = entries();
+  expectError([&](const std::string& p) { writeResultYaml(p, r, ResultMetadata{}); }, dir_target,
+              -1);
+  EXPECT_TRUE(std::filesystem::is_directory(dir_target));
+  EXPECT_EQ(entries(), entries_before);
+}
+
+TEST(ResultYaml, ReadOnlyDirectoryKeepsThePreviousFile) {
+  if (geteuid() == 0) GTEST_SKIP() << "root ignores directory permissions";
+  const std::string dir = tempDir() + "read_only/";
+  std::filesystem::create_directory(dir);
+  ASSERT_TRUE(std::filesystem::is_directory(dir));
+  const std::string path = dir + "result.yaml";
+  const Eigen::Matrix3d before = test::axisAngle(kX, 0.3);
+  writeResultYaml(path, knownResult(before), ResultMetadata{});
+  ASSERT_EQ(chmod(dir.c_str(), 0555), 0);
+  EXPECT_THROW(writeResultYaml(path, knownResult(Eigen::Matrix3d::Identity()), ResultMetadata{}),
+               InputError);
+  chmod(dir.c_str(), 0755);
+  EXPECT_ROTATION_NEAR_DEG(readResultYaml(path).R_cam_imu, before, 1e-9);
+}
+
+TEST(ResultYaml, ReaderErrorsNameTheFileAndTheProblem) {
+  const auto read = [](const std::string& p) { return readResultYaml(p); };
+  expectError(read, "/nonexistent_dir/result.yaml", -1);
+  expectError(read, writeTemp("invalid.yaml", "camera_frame: c\nR_cam_imu: [unclosed\n"), 0);
+  expectError(read, writeTemp("tabs.yaml", "R_cam_imu:\n\tquaternion_xyzw: [0, 0, 0, 1]\n"), 0);
+  expectError(read, writeTemp("nokey.yaml", "camera_frame: c\n"), -1, {"R_cam_imu"});
+  expectError(read, writeTemp("empty.yaml", ""), -1, {"R_cam_imu"});
+  expectError(read, writeTemp("scalar.yaml", "just text\n"), -1);
+  expectError(read, writeTemp("scalar_rot.yaml", "R_cam_imu: 5\n"), -1);
+  expectError(read, writeTemp("neither.yaml", "R_cam_imu:\n  angle: 1\n"), -1, {"R_cam_imu"});
+  expectError(read, writeTemp("badq.yaml", "R_cam_imu:\n  quaternion_xyzw: [0, 0, 0, 2]\n"), -1,
+              {"quaternion_xyzw", "unit"});
+  expectError(read, writeTemp("zeroq.yaml", "R_cam_imu:\n  quaternion_xyzw: [0, 0, 0, 0]\n"), -1,
+              {"quaternion_xyzw"});
+  expectError(read, writeTemp("nanq.yaml", "R_cam_imu:\n  quaternion_xyzw: [.nan, 0, 0, 1]\n"), -1,
+              {"quaternion_xyzw"});
+  expectError(read, writeTemp("shortq.yaml", "R_cam_imu:\n  quaternion_xyzw: [0, 0, 1]\n"), -1,
+              {"quaternion_xyzw"});
+  expectError(read, writeTemp("textq.yaml", "R_cam_imu:\n  quaternion_xyzw: [a, b, c, d]\n"), -1);
+  expectError(read,
+              writeTemp("badm.yaml", "R_cam_imu:\n  matrix: [[1, 0, 0], [0, 1, 0], [0, 0, 2]]\n"),
+              -1, {"matrix"});
+  expectError(read,
+              writeTemp("refl.yaml", "R_cam_imu:\n  matrix: [[1, 0, 0], [0, 1, 0], [0, 0, -1]]\n"),
+              -1, {"matrix"});
 }
 
 }  // namespace

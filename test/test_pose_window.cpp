@@ -1,5 +1,10 @@
-// Pose window and the pairs it forms.
+// Pose window and the pairs it forms (shared/CONVENTIONS.md: A = R_target_cam_k^T R_target_cam_t,
+// B = R_world_imu_k^T R_world_imu_t, A X = X B with X = R_cam_imu).
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+#include <utility>
 
 #include "camera_imu_alignment/alignment_solver.h"
 #include "camera_imu_alignment/pose_window.h"
@@ -8,8 +13,10 @@
 namespace camera_imu_alignment {
 namespace {
 
+/// Noise-free poses of a rig with R_cam_imu = X: R_target_cam_k = C R_world_imu_k X^T for a fixed,
+/// arbitrary C = R_target_world.
 std::vector<PoseOrientation> exactPoses(std::mt19937_64& rng, const Eigen::Matrix3d& X, int count) {
-  const Eigen::Matrix3d C = test::randomRotation(rng);  // R_target_world, arbitrary
+  const Eigen::Matrix3d C = test::randomRotation(rng);
   std::vector<PoseOrientation> poses;
   for (int k = 0; k < count; ++k) {
     PoseOrientation p;
@@ -24,10 +31,19 @@ std::vector<PoseOrientation> exactPoses(std::mt19937_64& rng, const Eigen::Matri
 TEST(PoseWindow, KeepsTheMostRecentPoses) {
   std::mt19937_64 rng(41);
   PoseWindow window(5);
-  for (const auto& p : exactPoses(rng, test::randomRotation(rng), 8)) EXPECT_TRUE(window.add(p));
+  EXPECT_EQ(window.maxPoses(), 5u);
+  const auto poses = exactPoses(rng, test::randomRotation(rng), 8);
+  for (size_t k = 0; k < poses.size(); ++k) {
+    EXPECT_TRUE(window.add(poses[k]));
+    EXPECT_EQ(window.size(), std::min<size_t>(k + 1, 5));
+    EXPECT_EQ(window.poses().back().stamp_s, poses[k].stamp_s);
+  }
   ASSERT_EQ(window.size(), 5u);
-  EXPECT_EQ(window.poses().front().stamp_s, 3.0);
-  EXPECT_EQ(window.poses().back().stamp_s, 7.0);
+  for (size_t i = 0; i < 5; ++i) {
+    EXPECT_EQ(window.poses()[i].stamp_s, poses[i + 3].stamp_s);
+    EXPECT_EQ(window.poses()[i].R_target_cam, poses[i + 3].R_target_cam);
+    EXPECT_EQ(window.poses()[i].R_world_imu, poses[i + 3].R_world_imu);
+  }
   window.clear();
   EXPECT_EQ(window.size(), 0u);
   EXPECT_TRUE(window.makePairs().empty());
@@ -35,37 +51,94 @@ TEST(PoseWindow, KeepsTheMostRecentPoses) {
 
 TEST(PoseWindow, RejectsNonRotationsAndKeepsWhatItHad) {
   std::mt19937_64 rng(42);
-  PoseWindow window(10);
+  PoseWindow window(3);
   const auto poses = exactPoses(rng, test::randomRotation(rng), 3);
-  for (const auto& p : poses) window.add(p);
-  PoseOrientation nan_pose = poses[0];
-  nan_pose.R_target_cam(0, 0) = std::nan("");
-  EXPECT_FALSE(window.add(nan_pose));
-  PoseOrientation scaled = poses[0];
-  scaled.R_world_imu *= 1.1;
-  EXPECT_FALSE(window.add(scaled));
-  EXPECT_EQ(window.size(), 3u);
+  for (const auto& p : poses) ASSERT_TRUE(window.add(p));
+  std::vector<PoseOrientation> bad(6, poses[0]);
+  bad[0].R_target_cam(0, 0) = std::nan("");
+  bad[1].R_world_imu(2, 1) = INFINITY;
+  bad[2].R_world_imu *= 1.1;                     // scaled
+  bad[3].R_target_cam *= 0.9;                    // scaled
+  bad[4].R_target_cam = -poses[0].R_target_cam;  // det -1
+  bad[5].R_world_imu = Eigen::Matrix3d::Zero();  // not a rotation at all
+  for (size_t i = 0; i < bad.size(); ++i) {
+    EXPECT_FALSE(window.add(bad[i])) << i;
+    // The window is full: a rejected pose must not push the oldest out either.
+    ASSERT_EQ(window.size(), 3u) << i;
+    for (size_t k = 0; k < 3; ++k) {
+      EXPECT_EQ(window.poses()[k].stamp_s, poses[k].stamp_s);
+      EXPECT_EQ(window.poses()[k].R_target_cam, poses[k].R_target_cam);
+      EXPECT_EQ(window.poses()[k].R_world_imu, poses[k].R_world_imu);
+    }
+  }
+  EXPECT_EQ(window.makePairs().size(), 3u);
 }
 
 TEST(PoseWindow, FormsAllPairsWithTheConventionsRelativeRotations) {
   std::mt19937_64 rng(43);
   const Eigen::Matrix3d X = test::randomRotation(rng);
-  const auto poses = exactPoses(rng, X, 7);
-  PoseWindow window(7);
+  for (int P : {0, 1, 2, 3, 7}) {
+    const auto poses = exactPoses(rng, X, P);
+    PoseWindow window(10);
+    for (const auto& p : poses) ASSERT_TRUE(window.add(p));
+    const RotationPairs pairs = window.makePairs();
+    ASSERT_EQ(pairs.size(), static_cast<size_t>(P * (P - 1) / 2)) << P;
+    std::set<std::pair<int, int>> seen;
+    for (const auto& pair : pairs) {
+      ASSERT_GE(pair.pose_k, 0);
+      ASSERT_LT(pair.pose_k, pair.pose_t);
+      ASSERT_LT(pair.pose_t, P);
+      EXPECT_TRUE(seen.insert({pair.pose_k, pair.pose_t}).second) << "duplicate pair";
+      const auto& k = poses[pair.pose_k];
+      const auto& t = poses[pair.pose_t];
+      EXPECT_LT((pair.A_cam - k.R_target_cam.transpose() * t.R_target_cam).norm(), 1e-13);
+      EXPECT_LT((pair.B_imu - k.R_world_imu.transpose() * t.R_world_imu).norm(), 1e-13);
+      EXPECT_LT((pair.A_cam * X - X * pair.B_imu).norm(), 1e-12);  // A X = X B
+    }
+    // makeAllPairs over the same poses gives the same pairs.
+    const RotationPairs direct = makeAllPairs(poses);
+    ASSERT_EQ(direct.size(), pairs.size());
+    for (size_t j = 0; j < pairs.size(); ++j) {
+      EXPECT_EQ(direct[j].pose_k, pairs[j].pose_k);
+      EXPECT_EQ(direct[j].pose_t, pairs[j].pose_t);
+      EXPECT_EQ(direct[j].A_cam, pairs[j].A_cam);
+      EXPECT_EQ(direct[j].B_imu, pairs[j].B_imu);
+    }
+  }
+}
+
+TEST(PoseWindow, PairIndicesReferToTheWindowAfterOldPosesLeft) {
+  std::mt19937_64 rng(44);
+  const Eigen::Matrix3d X = test::randomRotation(rng);
+  const auto poses = exactPoses(rng, X, 9);
+  PoseWindow window(4);
   for (const auto& p : poses) window.add(p);
   const RotationPairs pairs = window.makePairs();
-  ASSERT_EQ(pairs.size(), 21u);
+  ASSERT_EQ(pairs.size(), 6u);
   for (const auto& pair : pairs) {
-    ASSERT_LT(pair.pose_k, pair.pose_t);
-    const auto& k = poses[pair.pose_k];
-    const auto& t = poses[pair.pose_t];
-    EXPECT_LT((pair.A_cam - k.R_target_cam.transpose() * t.R_target_cam).norm(), 1e-15);
-    EXPECT_LT((pair.B_imu - k.R_world_imu.transpose() * t.R_world_imu).norm(), 1e-15);
-    EXPECT_LT((pair.A_cam * X - X * pair.B_imu).norm(), 1e-12);  // A X = X B
+    ASSERT_LT(pair.pose_t, 4);
+    const auto& k = poses[5 + pair.pose_k];  // the window holds poses 5..8
+    const auto& t = poses[5 + pair.pose_t];
+    EXPECT_LT((pair.A_cam - k.R_target_cam.transpose() * t.R_target_cam).norm(), 1e-13);
+    EXPECT_LT((pair.B_imu - k.R_world_imu.transpose() * t.R_world_imu).norm(), 1e-13);
   }
-  const AlignmentResult r = solveAlignment(pairs);
-  ASSERT_EQ(r.status, SolveStatus::kOk) << r.message;
-  EXPECT_LT(test::angleBetweenDeg(r.R_cam_imu, X), 1e-9);
+}
+
+TEST(PoseWindow, NoiseFreePosesAreSolvedExactly) {
+  std::mt19937_64 rng(45);
+  for (int trial = 0; trial < 5; ++trial) {
+    const Eigen::Matrix3d X = test::randomRotation(rng);
+    PoseWindow window(8);
+    for (const auto& p : exactPoses(rng, X, 8)) ASSERT_TRUE(window.add(p));
+    const RotationPairs pairs = window.makePairs();
+    ASSERT_EQ(pairs.size(), 28u);
+    const AlignmentResult r = solveAlignment(pairs);
+    ASSERT_EQ(r.status, SolveStatus::kOk) << r.message;
+    EXPECT_LT(test::angleBetweenDeg(r.R_cam_imu, X), 1e-9) << "trial " << trial;
+    EXPECT_TRUE(r.quality.observable);
+    EXPECT_EQ(r.quality.num_pairs, 28);
+    EXPECT_EQ(r.quality.num_inliers, 28);
+  }
 }
 
 }  // namespace

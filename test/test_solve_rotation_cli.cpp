@@ -4,10 +4,11 @@
 #include <sys/wait.h>
 #include <yaml-cpp/yaml.h>
 
-#include <array>
-#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <random>
+#include <regex>
 
 #include "camera_imu_alignment/csv_io.h"
 #include "camera_imu_alignment/result_yaml.h"
@@ -16,31 +17,30 @@
 namespace camera_imu_alignment {
 namespace {
 
-struct RunResult {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-/// Runs a command under `timeout` (a hang fails the test instead of blocking it).
-RunResult run(const std::string& args) {
-  const std::string dir = ::testing::TempDir();
-  const std::string out_path = dir + "cia_cli_stdout.txt", err_path = dir + "cia_cli_stderr.txt";
-  const std::string cmd = "timeout 60 " + args + " >" + out_path + " 2>" + err_path;
-  const int status = std::system(cmd.c_str());
-  RunResult r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream out(out_path), err(err_path);
-  r.out.assign(std::istreambuf_iterator<char>(out), {});
-  r.err.assign(std::istreambuf_iterator<char>(err), {});
-  return r;
-}
-
 const std::string kSolve = SOLVE_ROTATION_EXE;
 const std::string kGenerate = GENERATE_EXAMPLE_EXE;
 const std::string kData = TEST_DATA_DIR;
 
-std::string temp(const std::string& name) { return ::testing::TempDir() + "cia_cli_" + name; }
+/// A directory of this process alone (other workspaces may run the same test at the same time),
+/// removed at exit.
+const std::string& tempDir() {
+  struct TempDir {
+    std::string path;
+    TempDir() {
+      std::string pattern = ::testing::TempDir() + "cia_cli_XXXXXX";
+      if (!mkdtemp(&pattern[0])) std::abort();
+      path = pattern + "/";
+    }
+    ~TempDir() {
+      std::error_code ignored;
+      std::filesystem::remove_all(path, ignored);
+    }
+  };
+  static const TempDir dir;
+  return dir.path;
+}
+
+std::string temp(const std::string& name) { return tempDir() + name; }
 
 std::string writeFile(const std::string& name, const std::string& text) {
   const std::string path = temp(name);
@@ -48,33 +48,101 @@ std::string writeFile(const std::string& name, const std::string& text) {
   return path;
 }
 
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+struct RunResult {
+  int exit_code = -1;  ///< -1: killed by a signal (a crash); 124: timed out
+  std::string out;
+  std::string err;
+};
+
+/// Runs a command under `timeout` (a hang fails the test instead of blocking it).
+RunResult run(const std::string& args) {
+  const std::string out_path = temp("stdout.txt"), err_path = temp("stderr.txt");
+  const std::string cmd = "timeout 60 " + args + " >" + out_path + " 2>" + err_path;
+  const int status = std::system(cmd.c_str());
+  RunResult r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = readFile(out_path);
+  r.err = readFile(err_path);
+  return r;
+}
+
 Eigen::Matrix3d resultRotation(const std::string& yaml_text) {
   const auto q = YAML::Load(yaml_text)["R_cam_imu"]["quaternion_xyzw"].as<std::vector<double>>();
   return Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix();
 }
 
+/// The truth written in a golden file's first line: "# truth ... [x, y, z, w] ...".
+Eigen::Matrix3d goldenTruth(const std::string& path) {
+  std::ifstream in(path);
+  std::string first;
+  std::getline(in, first);
+  std::smatch m;
+  const std::string num = "(-?[0-9.eE+-]+)";
+  if (!std::regex_search(
+          first, m,
+          std::regex("^# truth .*\\[" + num + ", " + num + ", " + num + ", " + num + "\\]"))) {
+    ADD_FAILURE() << path << " has no '# truth ... [x, y, z, w]' first line: " << first;
+    return Eigen::Matrix3d::Identity();
+  }
+  return Eigen::Quaterniond(std::stod(m[4]), std::stod(m[1]), std::stod(m[2]), std::stod(m[3]))
+      .normalized()
+      .toRotationMatrix();
+}
+
 TEST(SolveRotationCli, HelpExitsZero) {
-  const RunResult r = run(kSolve + " --help");
-  EXPECT_EQ(r.exit_code, 0);
-  EXPECT_NE(r.out.find("--pairs"), std::string::npos);
+  for (const std::string flag : {"--help", "-h"}) {
+    const RunResult r = run(kSolve + " " + flag);
+    EXPECT_EQ(r.exit_code, 0) << flag;
+    EXPECT_NE(r.out.find("--pairs"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("--poses"), std::string::npos) << r.out;
+  }
+  EXPECT_EQ(run(kGenerate + " --help").exit_code, 0);
+}
+
+TEST(SolveRotationCli, GoldenFilesAreNoiseFreeForTheTruthInTheirComment) {
+  const Eigen::Matrix3d X = goldenTruth(kData + "/pairs_golden.csv");
+  const RotationPairs pairs = readPairsCsv(kData + "/pairs_golden.csv");
+  ASSERT_GE(pairs.size(), 3u);
+  for (const auto& p : pairs) EXPECT_LT((p.A_cam * X - X * p.B_imu).norm(), 1e-14);
+  const Eigen::Matrix3d Xp = goldenTruth(kData + "/poses_golden.csv");
+  const auto poses = readPosesCsv(kData + "/poses_golden.csv");
+  ASSERT_EQ(poses.size(), 6u);
+  // R_target_cam_k X R_world_imu_k^T = R_target_world is the same at every pose.
+  const Eigen::Matrix3d C = poses[0].R_target_cam * Xp * poses[0].R_world_imu.transpose();
+  for (const auto& p : poses)
+    EXPECT_LT((p.R_target_cam * Xp * p.R_world_imu.transpose() - C).norm(), 1e-14);
 }
 
 TEST(SolveRotationCli, GoldenPairsFileIsSolvedExactly) {
-  // test/data/pairs_golden.csv: noise-free pairs of a known mounting (in its first comment line).
-  const Eigen::Matrix3d truth = Eigen::Quaterniond(0.4849133775367413, 0.49991250255205361,
-                                                   -0.50991191922892842, 0.5049122108904911)
-                                    .toRotationMatrix();
-  const RunResult r = run(kSolve + " --pairs " + kData + "/pairs_golden.csv");
+  const std::string path = kData + "/pairs_golden.csv";
+  const RunResult r = run(kSolve + " --pairs " + path);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_LT(test::angleBetweenDeg(resultRotation(r.out), truth), 1e-6);
-  EXPECT_EQ(YAML::Load(r.out)["solver"]["method"].as<std::string>(), "optimal");
+  EXPECT_LT(test::angleBetweenDeg(resultRotation(r.out), goldenTruth(path)), 1e-6);
+  const YAML::Node y = YAML::Load(r.out);
+  EXPECT_EQ(y["solver"]["method"].as<std::string>(), "optimal");
+  EXPECT_EQ(y["quality"]["num_pairs"].as<size_t>(), readPairsCsv(path).size());
+  EXPECT_TRUE(y["quality"]["observable"].as<bool>());
   // This mounting is 120 deg from the identity: the paper's two-step, started there, settles on a
   // wrong fixed point. The tool must say so (exit 3), not hand it out as a result.
-  const RunResult two_step =
-      run(kSolve + " --pairs " + kData + "/pairs_golden.csv --method two_step");
+  const RunResult two_step = run(kSolve + " --pairs " + path + " --method two_step");
   EXPECT_EQ(two_step.exit_code, 3) << two_step.err;
   EXPECT_NE(two_step.err.find("does not fit"), std::string::npos) << two_step.err;
   EXPECT_EQ(YAML::Load(two_step.out)["solver"]["method"].as<std::string>(), "two_step");
+}
+
+TEST(SolveRotationCli, GoldenPosesFileIsSolvedExactly) {
+  const std::string path = kData + "/poses_golden.csv";
+  const RunResult r = run(kSolve + " --poses " + path);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_LT(test::angleBetweenDeg(resultRotation(r.out), goldenTruth(path)), 1e-6);
+  const YAML::Node y = YAML::Load(r.out);
+  EXPECT_EQ(y["quality"]["num_poses"].as<int>(), 6);
+  EXPECT_EQ(y["quality"]["num_pairs"].as<int>(), 15);
 }
 
 TEST(SolveRotationCli, TwoStepMethodSolvesAModerateMounting) {
@@ -91,27 +159,35 @@ TEST(SolveRotationCli, TwoStepMethodSolvesAModerateMounting) {
 }
 
 TEST(SolveRotationCli, GeneratedExampleWithinItsOneSigma) {
-  const std::string poses = temp("poses.csv"), truth_path = temp("truth.yaml"),
-                    output = temp("out.yaml");
+  const std::string poses = temp("poses.csv"), truth_path = temp("truth.yaml");
   ASSERT_EQ(
       run(kGenerate + " --seed 3 --poses-out " + poses + " --truth-out " + truth_path).exit_code,
       0);
-  const RunResult r =
-      run(kSolve + " --poses " + poses + " --truth " + truth_path + " --output " + output);
+  const RunResult r = run(kSolve + " --poses " + poses + " --truth " + truth_path);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_TRUE(r.out.empty()) << "--output must keep stdout free";
-  EXPECT_NE(r.err.find("error to the truth"), std::string::npos);
-  const YAML::Node y = YAML::LoadFile(output);
+  EXPECT_NE(r.err.find("error to the truth"), std::string::npos) << r.err;
+  const YAML::Node y = YAML::Load(r.out);  // the result goes to stdout
   const Eigen::Matrix3d truth = readResultYaml(truth_path).R_cam_imu;
-  const Eigen::Matrix3d estimate = readResultYaml(output).R_cam_imu;
   const auto sigma = y["quality"]["std_dev_deg"].as<std::vector<double>>();
+  ASSERT_EQ(sigma.size(), 3u);
   const double sigma_norm =
       std::sqrt(sigma[0] * sigma[0] + sigma[1] * sigma[1] + sigma[2] * sigma[2]);
-  const double error = test::angleBetweenDeg(estimate, truth);
+  const double error = test::angleBetweenDeg(resultRotation(r.out), truth);
+  EXPECT_GT(sigma_norm, 0.0);
   EXPECT_LT(error, 3.0 * sigma_norm);
   EXPECT_LT(error, 1.0);
+  EXPECT_TRUE(y["quality"]["observable"].as<bool>());
   EXPECT_EQ(y["quality"]["num_poses"].as<int>(), 12);
   EXPECT_EQ(y["quality"]["num_pairs"].as<int>(), 66);
+
+  // --output: the same document in the file, nothing on stdout.
+  const std::string output = temp("out.yaml");
+  const RunResult to_file =
+      run(kSolve + " --poses " + poses + " --truth " + truth_path + " --output " + output);
+  ASSERT_EQ(to_file.exit_code, 0) << to_file.err;
+  EXPECT_TRUE(to_file.out.empty()) << "--output must keep stdout free: " << to_file.out;
+  EXPECT_EQ(readFile(output), r.out);
+  EXPECT_LT(test::angleBetweenDeg(readResultYaml(output).R_cam_imu, resultRotation(r.out)), 1e-9);
 }
 
 TEST(SolveRotationCli, PairsFileFromPosesGivesTheSameAnswer) {
@@ -125,6 +201,10 @@ TEST(SolveRotationCli, PairsFileFromPosesGivesTheSameAnswer) {
   const RunResult from_poses = run(kSolve + " --poses " + poses);
   ASSERT_EQ(from_pairs.exit_code, 0) << from_pairs.err;
   ASSERT_EQ(from_poses.exit_code, 0) << from_poses.err;
+  EXPECT_EQ(YAML::Load(from_pairs.out)["quality"]["num_pairs"].as<int>(), 66);
+  EXPECT_LT(
+      test::angleBetweenDeg(resultRotation(from_pairs.out), readResultYaml(truth_path).R_cam_imu),
+      1.0);
   // Same pairs, same estimate; only the covariance model differs (independent vs shared poses).
   EXPECT_LT(test::angleBetweenDeg(resultRotation(from_pairs.out), resultRotation(from_poses.out)),
             1e-6);
@@ -133,46 +213,61 @@ TEST(SolveRotationCli, PairsFileFromPosesGivesTheSameAnswer) {
 void expectBadInput(const std::string& args, const std::vector<std::string>& parts) {
   const RunResult r = run(kSolve + " " + args);
   EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
+  EXPECT_TRUE(r.out.empty()) << args << ": no result on bad input, got " << r.out;
   for (const auto& part : parts)
     EXPECT_NE(r.err.find(part), std::string::npos) << args << ": " << r.err;
 }
 
 TEST(SolveRotationCli, BadInputExitsTwoNamingFileAndLine) {
   const std::string header = "qa_w,qa_x,qa_y,qa_z,qb_w,qb_x,qb_y,qb_z\n";
-  expectBadInput("--pairs /nonexistent/pairs.csv", {"/nonexistent/pairs.csv"});
-  expectBadInput("--pairs " + writeFile("hdr.csv", "a,b,c\n1,2,3\n"), {"hdr.csv:1", "header"});
+  const std::string golden = kData + "/pairs_golden.csv";
+  expectBadInput("--pairs /nonexistent_dir/pairs.csv", {"/nonexistent_dir/pairs.csv"});
+  expectBadInput("--poses /nonexistent_dir/poses.csv", {"/nonexistent_dir/poses.csv"});
+  expectBadInput("--pairs " + writeFile("hdr.csv", "a,b,c\n1,2,3\n"), {"hdr.csv:1", "qa_w"});
   expectBadInput("--pairs " + writeFile("nan.csv", header + "1,0,0,0,1,0,0,0\nnan,0,0,0,1,0,0,0\n"),
-                 {"nan.csv:3"});
+                 {"nan.csv:3", "qa_w"});
+  expectBadInput("--pairs " + writeFile("inf.csv", "# c\n" + header + "1,0,0,0,1,0,inf,0\n"),
+                 {"inf.csv:3", "qb_y"});
   expectBadInput("--pairs " + writeFile("rows.csv", header), {"rows.csv", "no data rows"});
   expectBadInput("--pairs " + writeFile("unit.csv", header + "2,0,0,0,1,0,0,0\n"),
                  {"unit.csv:2", "norm"});
+  expectBadInput("--pairs " + writeFile("zero.csv", header + "1,0,0,0,0,0,0,0\n"),
+                 {"zero.csv:2", "norm"});
   expectBadInput("--poses " + writeFile("poses_hdr.csv", header + "1,0,0,0,1,0,0,0\n"),
                  {"poses_hdr.csv:1", "stamp"});
-  expectBadInput("--bogus", {"unknown argument"});
-  expectBadInput("", {"exactly one"});
-  expectBadInput("--pairs a.csv --poses b.csv", {"exactly one"});
-  expectBadInput("--pairs " + kData + "/pairs_golden.csv --method bogus", {"--method"});
-  expectBadInput("--pairs " + kData + "/pairs_golden.csv --max-iterations 0", {"--max-iterations"});
-  expectBadInput("--pairs " + kData + "/pairs_golden.csv --max-iterations abc",
-                 {"--max-iterations"});
-  expectBadInput("--pairs " + kData + "/pairs_golden.csv --max-iterations", {"needs a value"});
-  expectBadInput("--pairs " + kData + "/pairs_golden.csv --truth /nonexistent/t.yaml",
-                 {"/nonexistent/t.yaml"});
+  expectBadInput("--bogus", {"--bogus"});
+  expectBadInput("--pairs " + golden + " --bogus 1", {"--bogus"});
+  expectBadInput("", {"--pairs", "--poses"});
+  expectBadInput("--pairs " + golden + " --poses " + kData + "/poses_golden.csv", {"exactly one"});
+  expectBadInput("--pairs " + golden + " --method bogus", {"--method", "bogus"});
+  expectBadInput("--pairs " + golden + " --max-iterations 0", {"--max-iterations", "'0'"});
+  expectBadInput("--pairs " + golden + " --max-iterations abc", {"--max-iterations", "abc"});
+  expectBadInput("--pairs " + golden + " --max-iterations -3", {"--max-iterations"});
+  expectBadInput("--pairs " + golden + " --max-iterations", {"--max-iterations"});
+  expectBadInput("--pairs " + golden + " --truth /nonexistent_dir/t.yaml",
+                 {"/nonexistent_dir/t.yaml"});
+  expectBadInput("--pairs " + golden + " --truth " + writeFile("t.yaml", "camera_frame: c\n"),
+                 {"t.yaml", "R_cam_imu"});
 }
 
-TEST(SolveRotationCli, GarbageFilesNeverCrash) {
+TEST(SolveRotationCli, GarbageFilesExitTwoWithoutCrashing) {
   std::mt19937_64 rng(61);
   for (int trial = 0; trial < 20; ++trial) {
     std::string bytes(1 + rng() % 4000, '\0');
     for (auto& c : bytes) c = static_cast<char>(rng() % 256);
     if (trial % 2) bytes = "qa_w,qa_x,qa_y,qa_z,qb_w,qb_x,qb_y,qb_z\n" + bytes;
-    const RunResult r = run(kSolve + " --pairs " + writeFile("garbage.csv", bytes));
-    EXPECT_TRUE(r.exit_code == 2 || r.exit_code == 3) << "exit " << r.exit_code << ": " << r.err;
+    const std::string path = writeFile("garbage" + std::to_string(trial) + ".csv", bytes);
+    const RunResult r = run(kSolve + " --pairs " + path);
+    EXPECT_EQ(r.exit_code, 2) << "trial " << trial << ": " << r.err;
+    EXPECT_NE(r.err.find(path), std::string::npos) << r.err;
+    const RunResult poses = run(kSolve + " --poses " + path);
+    EXPECT_EQ(poses.exit_code, 2) << "trial " << trial << ": " << poses.err;
   }
 }
 
 TEST(SolveRotationCli, SingleAxisMotionExitsThreeNamingTheAxis) {
-  // All camera rotations about camera z (the IMU axis R^T z): not observable about camera z.
+  // All IMU rotations about the IMU axis X^T z, so all camera rotations about camera z: the
+  // rotation about camera z is not observable.
   std::mt19937_64 rng(62);
   const Eigen::Matrix3d X = test::randomRotation(rng);
   RotationPairs pairs;
@@ -198,12 +293,14 @@ TEST(SolveRotationCli, TooLittleDataExitsThree) {
                     "0,1,0,0,0,1,0,0,0\n"));
   EXPECT_EQ(one_pose.exit_code, 3) << one_pose.err;
   EXPECT_NE(one_pose.err.find("single pose"), std::string::npos) << one_pose.err;
+  // One pair fixes the rotation only up to a turn about its axis: not observable.
   const RunResult one_pair = run(kSolve + " --pairs " +
                                  writeFile("one_pair.csv",
                                            "qa_w,qa_x,qa_y,qa_z,qb_w,qb_x,qb_y,qb_z\n"
                                            "0.9,0.43588989,0,0,0.9,0,0.43588989,0\n"));
   EXPECT_EQ(one_pair.exit_code, 3) << one_pair.err;
   EXPECT_NE(one_pair.err.find("rotate the rig about"), std::string::npos) << one_pair.err;
+  EXPECT_FALSE(YAML::Load(one_pair.out)["quality"]["observable"].as<bool>());
 }
 
 }  // namespace

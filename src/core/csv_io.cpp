@@ -1,7 +1,6 @@
 #include "camera_imu_alignment/csv_io.h"
 
 #include <Eigen/Geometry>
-#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -35,6 +34,7 @@ class CsvTable {
     if (!in) throw InputError(path + ": cannot open file");
     std::string line;
     int line_no = 0;
+    int header_line = 0;
     bool have_header = false;
     while (std::getline(in, line)) {
       ++line_no;
@@ -52,13 +52,19 @@ class CsvTable {
                            missing + " (header: '" + t + "')");
         }
         have_header = true;
+        header_line = line_no;
         continue;
       }
       rows_.push_back({line_no, splitComma(t)});
     }
     if (in.bad()) throw InputError(path + ": read error");
-    if (!have_header) throw InputError(path + ": empty file (no header row)");
-    if (rows_.empty()) throw InputError(path + ": no data rows after the header");
+    // Name the last line read (a zero-byte file has none).
+    const std::string at = line_no > 0 ? ":" + std::to_string(line_no) : "";
+    if (!have_header) throw InputError(path + at + ": empty file (no header row)");
+    if (rows_.empty()) {
+      throw InputError(path + ":" + std::to_string(header_line) +
+                       ": no data rows after the header");
+    }
   }
 
   size_t size() const { return rows_.size(); }
@@ -70,11 +76,10 @@ class CsvTable {
     if (c >= cells.size() || cells[c].empty()) fail(row, "missing value for column " + column);
     const char* text = cells[c].c_str();
     char* end = nullptr;
-    errno = 0;
     const double v = std::strtod(text, &end);
     if (end == text || *end != '\0')
       fail(row, "column " + column + ": '" + cells[c] + "' is not a number");
-    if (!std::isfinite(v) || errno == ERANGE)
+    if (!std::isfinite(v))
       fail(row, "column " + column + ": value '" + cells[c] + "' is not finite");
     return v;
   }
@@ -82,7 +87,10 @@ class CsvTable {
   /// Reads four columns as a quaternion (w, x, y, z), checks its norm and normalises it.
   Eigen::Quaterniond quaternion(size_t row, const std::string& w, const std::string& x,
                                 const std::string& y, const std::string& z) const {
-    Eigen::Quaterniond q(value(row, w), value(row, x), value(row, y), value(row, z));
+    // Read in column order (argument evaluation order is unspecified): the first missing or bad
+    // column is the one reported.
+    const double qw = value(row, w), qx = value(row, x), qy = value(row, y), qz = value(row, z);
+    Eigen::Quaterniond q(qw, qx, qy, qz);
     const double norm = q.norm();
     if (std::abs(norm - 1.0) > kQuaternionNormTolerance) {
       std::ostringstream msg;
