@@ -18,24 +18,7 @@
 namespace camera_imu_alignment {
 namespace {
 
-/// A directory of this process alone (other workspaces may run the same test at the same time),
-/// removed at exit.
-const std::string& tempDir() {
-  struct TempDir {
-    std::string path;
-    TempDir() {
-      std::string pattern = ::testing::TempDir() + "cia_csv_XXXXXX";
-      if (!mkdtemp(&pattern[0])) std::abort();
-      path = pattern + "/";
-    }
-    ~TempDir() {
-      std::error_code ignored;
-      std::filesystem::remove_all(path, ignored);
-    }
-  };
-  static const TempDir dir;
-  return dir.path;
-}
+const std::string& tempDir() { return test::processTempDir(); }
 
 std::string writeTemp(const std::string& name, const std::string& text) {
   const std::string path = tempDir() + name;

@@ -6,7 +6,10 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <random>
+#include <string>
 
 #include "camera_imu_alignment/rotation_pair.h"
 
@@ -86,6 +89,25 @@ inline RotationPairs paperPairs(std::mt19937_64& rng, const Eigen::Matrix3d& X, 
     pairs.push_back(p);
   }
   return pairs;
+}
+
+/// A directory of this test process alone (other workspaces may run the same test at the same
+/// time), removed at exit; ends with '/'.
+inline const std::string& processTempDir() {
+  struct TempDir {
+    std::string path;
+    TempDir() {
+      std::string pattern = ::testing::TempDir() + "cia_test_XXXXXX";
+      if (!mkdtemp(&pattern[0])) std::abort();
+      path = pattern + "/";
+    }
+    ~TempDir() {
+      std::error_code ignored;
+      std::filesystem::remove_all(path, ignored);
+    }
+  };
+  static const TempDir dir;
+  return dir.path;
 }
 
 #define EXPECT_ROTATION_NEAR_DEG(R1, R2, tol_deg) \

@@ -21,24 +21,7 @@ const std::string kSolve = SOLVE_ROTATION_EXE;
 const std::string kGenerate = GENERATE_EXAMPLE_EXE;
 const std::string kData = TEST_DATA_DIR;
 
-/// A directory of this process alone (other workspaces may run the same test at the same time),
-/// removed at exit.
-const std::string& tempDir() {
-  struct TempDir {
-    std::string path;
-    TempDir() {
-      std::string pattern = ::testing::TempDir() + "cia_cli_XXXXXX";
-      if (!mkdtemp(&pattern[0])) std::abort();
-      path = pattern + "/";
-    }
-    ~TempDir() {
-      std::error_code ignored;
-      std::filesystem::remove_all(path, ignored);
-    }
-  };
-  static const TempDir dir;
-  return dir.path;
-}
+const std::string& tempDir() { return test::processTempDir(); }
 
 std::string temp(const std::string& name) { return tempDir() + name; }
 
