@@ -107,6 +107,27 @@ TEST(PoseWindow, FormsAllPairsWithTheConventionsRelativeRotations) {
   }
 }
 
+TEST(PoseWindow, PosesOfDifferentGroupsAreNeverPaired) {
+  // Two groups whose IMU world frames differ by an unknown heading: pairs across them would be
+  // wrong, pairs within each are exact.
+  std::mt19937_64 rng(47);
+  const Eigen::Matrix3d X = test::randomRotation(rng);
+  auto poses = exactPoses(rng, X, 6);
+  const Eigen::Matrix3d heading = test::axisAngle(Eigen::Vector3d::UnitZ(), 1.0);
+  for (int k = 3; k < 6; ++k) {
+    poses[k].group = 1;
+    poses[k].R_world_imu = heading * poses[k].R_world_imu;
+  }
+  const RotationPairs pairs = makeAllPairs(poses);
+  ASSERT_EQ(pairs.size(), 6u);  // 3 + 3, none of the 9 across
+  for (const auto& pair : pairs) {
+    EXPECT_EQ(poses[pair.pose_k].group, poses[pair.pose_t].group);
+    EXPECT_LT((pair.A_cam * X - X * pair.B_imu).norm(), 1e-12);
+  }
+  const AlignmentResult result = solveAlignment(pairs);
+  EXPECT_LT(test::angleBetweenDeg(result.R_cam_imu, X), 1e-6);
+}
+
 TEST(PoseWindow, PairIndicesReferToTheWindowAfterOldPosesLeft) {
   std::mt19937_64 rng(44);
   const Eigen::Matrix3d X = test::randomRotation(rng);

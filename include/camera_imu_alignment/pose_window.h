@@ -15,12 +15,15 @@ struct PoseOrientation {
   double stamp_s = 0.0;  ///< time of the pose (s), for ordering and reporting
   Eigen::Matrix3d R_target_cam = Eigen::Matrix3d::Identity();  ///< camera in the target frame (PnP)
   Eigen::Matrix3d R_world_imu = Eigen::Matrix3d::Identity();   ///< IMU in the world frame (ENU)
+  /// Poses of different groups are never paired: their world (or target) frames are unrelated,
+  /// e.g. IMU orientations from two gyro chains without a magnetometer heading between them.
+  int group = 0;
 };
 
 /// Keeps the most recent `max_poses` stationary poses (the mount may drift: old poses leave the
 /// window) and forms pairs from them.
 ///
-/// Pair choice: every pair (k, t), k < t, in the window. Each pose then informs the estimate
+/// Pair choice: every pair (k, t), k < t, in the window (of the same group). Each pose then informs the estimate
 /// through all the others, large relative rotations are never skipped, and the result does not
 /// depend on pose order (consecutive-only pairs would waste the information between distant poses).
 /// Pairs share poses, so their noise is correlated; each pair carries its pose indices and the
@@ -46,7 +49,7 @@ class PoseWindow {
   std::deque<PoseOrientation> poses_;
 };
 
-/// All pairs (k, t), k < t, of `poses` (see PoseWindow).
+/// All pairs (k, t), k < t, of `poses` within the same group (see PoseWindow).
 RotationPairs makeAllPairs(const std::vector<PoseOrientation>& poses);
 
 }  // namespace camera_imu_alignment
