@@ -15,7 +15,7 @@ struct RotationAverage {
   int num_outliers = 0;
 };
 
-/// Geodesic L1 mean (Weiszfeld on SO(3), started from the chordal median) followed by the L2 mean
+/// Geodesic L1 mean (Weiszfeld on SO(3), started from the medoid input) followed by the L2 mean
 /// of the rotations within `outlier_deg` of it. Empty input gives num_inliers = 0.
 RotationAverage averageRotations(const std::vector<Eigen::Matrix3d>& rotations,
                                  double outlier_deg = 2.0);

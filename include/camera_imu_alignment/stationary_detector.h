@@ -36,7 +36,8 @@ struct StationarySegment {
   Eigen::Vector3d mean_accel_m_s2 = Eigen::Vector3d::Zero();  ///< IMU frame
   Eigen::Vector3d gyro_bias_rad_s = Eigen::Vector3d::Zero();  ///< mean gyro over the segment
   double accel_norm_std_m_s2 = 0.0;
-  double gyro_norm_max_rad_s = 0.0;  ///< bias-compensated, over the segment
+  double gyro_norm_max_rad_s = 0.0;  ///< over the segment, compensated with the bias in use
+                                     ///< during detection (the previous segment's)
   int num_samples = 0;
   double duration() const { return end_s - start_s; }
 };

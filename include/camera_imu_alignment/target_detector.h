@@ -39,8 +39,18 @@ class TargetDetector {
   bool detect(const cv::Mat& mono8, TargetObservation* observation,
               const Eigen::Matrix3d* R_target_cam_hint = nullptr) const;
   const TargetDescription& target() const { return target_; }
+  /// Rotations S of the target frame (about its z axis, through the board centre; identity
+  /// excluded) under which this detector cannot tell the board from itself: the camera
+  /// orientation of a detection may be S * R_target_cam_true. A checkerboard with an even number
+  /// of inner corners along both axes looks the same turned by 180 degrees; a square grid also
+  /// turned by 90. AprilGrids have none (every tag has an id). The hint resolves these only while
+  /// the camera turns less than 90 degrees between hints; CalibrationPipeline checks each pose
+  /// against the IMU's rotation angle.
+  std::vector<Eigen::Matrix3d> symmetries() const;
 
  private:
+  bool detectAprilGrid(const cv::Mat& mono8, TargetObservation* observation) const;
+
   struct Impl;
   TargetDescription target_;
   DetectorSettings settings_;
@@ -60,6 +70,7 @@ struct CameraPose {
   Eigen::Matrix3d R_target_cam = Eigen::Matrix3d::Identity();
   Eigen::Vector3d p_target_cam = Eigen::Vector3d::Zero();  ///< camera centre in the target frame (m)
   double reprojection_rms_px = 0.0;
+  double reprojection_mean_px = 0.0;  ///< mean reprojection distance (px)
   double ambiguity_ratio = 0.0;  ///< second-best / best reprojection RMS of the planar solutions
   int num_points = 0;
 };
