@@ -31,10 +31,17 @@ struct MagnetometerCalibration {
   }
 };
 
+/// How much the field direction wandered during a rest (deg): the RMS angle between the mean
+/// directions of the rest's four consecutive quarters and the overall mean. Averaging makes it
+/// insensitive to the sensor's noise (a steady field gives the per-sample noise / sqrt(N / 4),
+/// whatever the noise's spectrum or sample-and-hold), while a magnet moving nearby shows up as
+/// its swing. Zero for fewer than 8 samples. Samples in stamp order, tesla.
+double fieldDirectionScatterDeg(const std::vector<Eigen::Vector3d>& fields_t);
+
 struct DisturbanceSettings {
   double max_norm_change = 0.08;   ///< relative change of |B| against the reference
   double max_dip_change_deg = 3.0; ///< change of the dip angle against the reference
-  double max_within_segment_std_deg = 1.0;  ///< direction scatter of the field inside a segment
+  double max_within_segment_std_deg = 1.0;  ///< fieldDirectionScatterDeg inside a segment
 };
 
 /// Disturbance detection per stationary segment against a running reference of the field norm

@@ -1,10 +1,17 @@
 // Stationary (at-rest) segments from the IMU stream.
 //
 // A sample is "at rest" when, over a sliding window of `window_s` centred on it,
-//   - the bias-compensated gyro norm stays below max_gyro_rad_s (bias: the mean gyro of the last
-//     stationary segment, zero before the first),
-//   - the standard deviation of the accelerometer norm stays below max_accel_std_m_s2, and
-//   - | |mean accel| - gravity | stays below max_gravity_error_m_s2.
+//   - the window's mean gyro, bias-compensated, is below max_gyro_rad_s (bias: the mean gyro of
+//     the last stationary segment; before the first one the bias is unknown and the raw mean must
+//     stay below max_initial_gyro_bias_rad_s),
+//   - the gyro's scatter about that mean (RMS of |gyro - mean|) is below
+//     max(max_gyro_std_rad_s, noise_factor x gyro noise),
+//   - the standard deviation of the accelerometer norm is below
+//     max(max_accel_std_m_s2, noise_factor x accelerometer noise), and
+//   - | |mean accel| - gravity | is below max_gravity_error_m_s2.
+// The noise terms adapt the limits to the sensor: the noise is measured from successive-sample
+// differences (white noise doubles their variance; motion is smooth at IMU rates), the quietest
+// window so far counting. A consumer-grade IMU thus needs no tuning; the fixed limits are floors.
 // Consecutive at-rest samples form a segment; a segment shorter than min_duration_s is dropped.
 // Segment ends are trimmed by half a window so that no motion leaks into the averages; the gyro
 // integration between segments covers the trimmed parts, so nothing is lost.
@@ -23,8 +30,11 @@ namespace camera_imu_alignment {
 struct StationaryDetectorSettings {
   double window_s = 1.0;                ///< sliding window length (s)
   double min_duration_s = 2.0;          ///< shortest segment emitted (s), after trimming
-  double max_gyro_rad_s = 0.03;         ///< bias-compensated gyro norm, every sample in the window
-  double max_accel_std_m_s2 = 0.06;     ///< std of |accel| over the window
+  double max_gyro_rad_s = 0.03;         ///< |window mean gyro - bias| (rad/s)
+  double max_initial_gyro_bias_rad_s = 0.1;  ///< |window mean gyro| before any bias is known
+  double max_gyro_std_rad_s = 0.01;     ///< RMS of |gyro - window mean|, floor (rad/s)
+  double max_accel_std_m_s2 = 0.06;     ///< std of |accel| over the window, floor (m/s^2)
+  double noise_factor = 2.0;  ///< limits >= this x the measured noise; 0: fixed limits only
   double max_gravity_error_m_s2 = 0.4;  ///< | |mean accel| - gravity_m_s2 |
   double gravity_m_s2 = 9.81;
   double max_gap_s = 0.1;  ///< a larger gap between samples ends the current segment

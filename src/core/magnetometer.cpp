@@ -1,6 +1,7 @@
 // Magnetometer unit check and disturbance detection against a running reference.
 #include "camera_imu_alignment/magnetometer.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -35,6 +36,22 @@ std::string describeFieldUnits(FieldUnits units, double norm, const std::string&
       break;
   }
   return out.str();
+}
+
+double fieldDirectionScatterDeg(const std::vector<Eigen::Vector3d>& fields_t) {
+  constexpr std::size_t kParts = 4;
+  if (fields_t.size() < 2 * kParts) return 0.0;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& f : fields_t) mean += f;
+  if (!(mean.norm() > 0.0) || !mean.allFinite()) return 0.0;
+  double sum_sq = 0.0;
+  for (std::size_t k = 0; k < kParts; ++k) {
+    const std::size_t begin = k * fields_t.size() / kParts, end = (k + 1) * fields_t.size() / kParts;
+    Eigen::Vector3d part = Eigen::Vector3d::Zero();
+    for (std::size_t i = begin; i < end; ++i) part += fields_t[i];
+    sum_sq += std::pow(std::atan2(part.cross(mean).norm(), part.dot(mean)), 2);
+  }
+  return std::sqrt(sum_sq / kParts) * 180.0 / M_PI;
 }
 
 MagneticDisturbanceDetector::MagneticDisturbanceDetector(const DisturbanceSettings& settings)

@@ -1,9 +1,11 @@
 // Streaming stationary detection with O(1) work per sample: running sums over the sliding window
-// and a count of samples whose gyro exceeds the threshold.
+// (accelerometer norm, gyro, and the squared differences of successive samples that measure the
+// sensor noise).
 #include "camera_imu_alignment/stationary_detector.h"
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace camera_imu_alignment {
 
@@ -12,7 +14,28 @@ namespace {
 struct WindowSample {
   ImuSample sample;
   double accel_norm_dev = 0.0;  ///< |accel| - g (m/s^2)
-  bool gyro_over = false;       ///< bias-compensated gyro norm above the threshold
+  double gyro_sq = 0.0;         ///< |gyro|^2
+  /// Squared differences to the previous sample (|accel| and gyro vector); zero for the first
+  /// sample after a (re)start, which `has_diff` marks.
+  double accel_diff_sq = 0.0, gyro_diff_sq = 0.0;
+  bool has_diff = false;
+};
+
+/// Window sums; add() / remove() keep them in O(1).
+struct WindowSums {
+  Eigen::Vector3d accel = Eigen::Vector3d::Zero(), gyro = Eigen::Vector3d::Zero();
+  double dev = 0.0, dev_sq = 0.0, gyro_sq = 0.0, accel_diff_sq = 0.0, gyro_diff_sq = 0.0;
+  int num_diff = 0;
+  void add(const WindowSample& w, double sign) {
+    accel += sign * w.sample.accel_m_s2;
+    gyro += sign * w.sample.gyro_rad_s;
+    dev += sign * w.accel_norm_dev;
+    dev_sq += sign * w.accel_norm_dev * w.accel_norm_dev;
+    gyro_sq += sign * w.gyro_sq;
+    accel_diff_sq += sign * w.accel_diff_sq;
+    gyro_diff_sq += sign * w.gyro_diff_sq;
+    num_diff += w.has_diff ? static_cast<int>(sign) : 0;
+  }
 };
 
 /// Sums of the samples that become part of a segment.
@@ -32,25 +55,20 @@ struct SegmentAccumulator {
 struct StationaryDetector::Impl {
   std::deque<WindowSample> window;   ///< samples in [newest - window_s, newest]
   std::deque<WindowSample> pending;  ///< samples after the last decided centre
-  Eigen::Vector3d accel_sum = Eigen::Vector3d::Zero();
-  double dev_sum = 0.0, dev_sq_sum = 0.0;
-  int num_over = 0;
+  WindowSums sums;
   std::size_t updates_since_recompute = 0;
   Eigen::Vector3d bias = Eigen::Vector3d::Zero();
+  bool bias_known = false;  ///< a segment has set `bias`
+  /// Quietest noise seen (the minimum over full windows of the successive-difference estimate):
+  /// accelerometer norm (m/s^2) and gyro vector magnitude (rad/s, RMS over the three axes).
+  double accel_noise_floor = std::numeric_limits<double>::infinity();
+  double gyro_noise_floor = std::numeric_limits<double>::infinity();
   bool at_rest = false;
   SegmentAccumulator segment;
 };
 
 StationaryDetector::StationaryDetector(const StationaryDetectorSettings& settings)
     : settings_(settings), impl_(std::make_shared<Impl>()) {}
-
-namespace {
-
-bool gyroOver(const ImuSample& s, const Eigen::Vector3d& bias, double limit) {
-  return (s.gyro_rad_s - bias).norm() > limit;
-}
-
-}  // namespace
 
 std::optional<StationarySegment> StationaryDetector::add(const ImuSample& sample) {
   Impl& d = *impl_;
@@ -67,48 +85,59 @@ std::optional<StationarySegment> StationaryDetector::add(const ImuSample& sample
       emitted = flush();
       d.window.clear();
       d.pending.clear();
-      d.accel_sum.setZero();
-      d.dev_sum = d.dev_sq_sum = 0.0;
-      d.num_over = 0;
+      d.sums = WindowSums();
     }
   }
   WindowSample entry;
   entry.sample = sample;
   entry.accel_norm_dev = sample.accel_m_s2.norm() - settings_.gravity_m_s2;
-  entry.gyro_over = gyroOver(sample, d.bias, settings_.max_gyro_rad_s);
+  entry.gyro_sq = sample.gyro_rad_s.squaredNorm();
+  if (!d.window.empty()) {
+    const WindowSample& previous = d.window.back();
+    const double da = entry.accel_norm_dev - previous.accel_norm_dev;
+    entry.accel_diff_sq = da * da;
+    entry.gyro_diff_sq = (sample.gyro_rad_s - previous.sample.gyro_rad_s).squaredNorm();
+    entry.has_diff = true;
+  }
   d.window.push_back(entry);
   d.pending.push_back(entry);
-  d.accel_sum += sample.accel_m_s2;
-  d.dev_sum += entry.accel_norm_dev;
-  d.dev_sq_sum += entry.accel_norm_dev * entry.accel_norm_dev;
-  d.num_over += entry.gyro_over;
+  d.sums.add(entry, 1.0);
   while (d.window.front().sample.stamp_s < sample.stamp_s - settings_.window_s) {
-    const WindowSample& old = d.window.front();
-    d.accel_sum -= old.sample.accel_m_s2;
-    d.dev_sum -= old.accel_norm_dev;
-    d.dev_sq_sum -= old.accel_norm_dev * old.accel_norm_dev;
-    d.num_over -= old.gyro_over;
+    d.sums.add(d.window.front(), -1.0);
     d.window.pop_front();
   }
   // Running sums drift by rounding: recompute them once per window length of updates.
   if (++d.updates_since_recompute > d.window.size()) {
-    d.accel_sum.setZero();
-    d.dev_sum = d.dev_sq_sum = 0.0;
-    for (const WindowSample& w : d.window) {
-      d.accel_sum += w.sample.accel_m_s2;
-      d.dev_sum += w.accel_norm_dev;
-      d.dev_sq_sum += w.accel_norm_dev * w.accel_norm_dev;
-    }
+    d.sums = WindowSums();
+    for (const WindowSample& w : d.window) d.sums.add(w, 1.0);
     d.updates_since_recompute = 0;
   }
 
   const double span = sample.stamp_s - d.window.front().sample.stamp_s;
   if (span < 0.9 * settings_.window_s) return emitted;  // window not filled yet
+  const WindowSums& w = d.sums;
   const double n = static_cast<double>(d.window.size());
-  const double mean_dev = d.dev_sum / n;
-  const double accel_std = std::sqrt(std::max(0.0, d.dev_sq_sum / n - mean_dev * mean_dev));
-  const double gravity_error = std::abs((d.accel_sum / n).norm() - settings_.gravity_m_s2);
-  const bool rest = d.num_over == 0 && accel_std <= settings_.max_accel_std_m_s2 &&
+  const double mean_dev = w.dev / n;
+  const double accel_std = std::sqrt(std::max(0.0, w.dev_sq / n - mean_dev * mean_dev));
+  const double gravity_error = std::abs((w.accel / n).norm() - settings_.gravity_m_s2);
+  const Eigen::Vector3d gyro_mean = w.gyro / n;
+  const double gyro_std = std::sqrt(std::max(0.0, w.gyro_sq / n - gyro_mean.squaredNorm()));
+  // White noise: successive differences have twice the variance of the samples, motion (smooth
+  // at IMU rates) adds little to them. The quietest window so far gives the sensor's noise.
+  if (w.num_diff > 0) {
+    d.accel_noise_floor =
+        std::min(d.accel_noise_floor, std::sqrt(w.accel_diff_sq / (2.0 * w.num_diff)));
+    d.gyro_noise_floor =
+        std::min(d.gyro_noise_floor, std::sqrt(w.gyro_diff_sq / (2.0 * w.num_diff)));
+  }
+  const double k = settings_.noise_factor;
+  const double accel_limit = std::max(settings_.max_accel_std_m_s2, k * d.accel_noise_floor);
+  const double gyro_std_limit = std::max(settings_.max_gyro_std_rad_s, k * d.gyro_noise_floor);
+  // Bias-compensated mean rate (the bias is zero until the first segment, hence its own limit).
+  const double gyro_mean_limit =
+      d.bias_known ? settings_.max_gyro_rad_s : settings_.max_initial_gyro_bias_rad_s;
+  const bool rest = accel_std <= accel_limit && gyro_std <= gyro_std_limit &&
+                    (gyro_mean - d.bias).norm() <= gyro_mean_limit &&
                     gravity_error <= settings_.max_gravity_error_m_s2;
   const double centre = 0.5 * (d.window.front().sample.stamp_s + sample.stamp_s);
   d.at_rest = rest;
@@ -158,13 +187,9 @@ std::optional<StationarySegment> StationaryDetector::flush() {
       std::sqrt(std::max(0.0, seg.norm_dev_sq_sum / seg.n - mean_dev * mean_dev));
   out.gyro_norm_max_rad_s = seg.gyro_norm_max;
   if (out.duration() < settings_.min_duration_s) return std::nullopt;
-  // The segment's mean gyro is the bias from now on; re-judge the samples in the window with it.
+  // The segment's mean gyro is the bias from now on.
   d.bias = out.gyro_bias_rad_s;
-  d.num_over = 0;
-  for (WindowSample& w : d.window) {
-    w.gyro_over = gyroOver(w.sample, d.bias, settings_.max_gyro_rad_s);
-    d.num_over += w.gyro_over;
-  }
+  d.bias_known = true;
   return out;
 }
 
