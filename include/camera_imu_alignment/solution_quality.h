@@ -50,7 +50,8 @@ struct SolutionQuality {
   int num_inliers = 0;
   double residual_rms_deg = 0.0;  ///< RMS of |r_j| over inliers (deg)
   /// Covariance of the left perturbation delta (rad^2, camera frame), from the Gauss-Newton
-  /// information scaled by the residual variance (pairs sharing a pose handled as correlated).
+  /// information scaled by the residual variance (pairs sharing a pose handled as correlated),
+  /// times dof / (dof - 2) for the noise scale estimated from few residuals (Student-t).
   Eigen::Matrix3d covariance_rad2 = Eigen::Matrix3d::Zero();
   /// 1-sigma about the camera x, y, z axes (deg); capped at 180 when not determined.
   Eigen::Vector3d std_dev_deg = Eigen::Vector3d::Constant(180.0);

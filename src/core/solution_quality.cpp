@@ -106,6 +106,9 @@ SolutionQuality evaluateQuality(const RotationPairs& pairs, const Eigen::Matrix3
 
   // Noise model and covariance.
   NoiseModel model;
+  // Independent noise dimensions behind the residuals, minus the 3 estimated: the degrees of
+  // freedom of the noise-scale estimate (pairs sharing poses carry no more noise than the poses).
+  double independent_dof = 3.0 * used.size() - 3.0;
   if (allPairsHavePoses(pairs, used)) {
     int num_poses = 0;
     for (int j : used) num_poses = std::max({num_poses, pairs[j].pose_k + 1, pairs[j].pose_t + 1});
@@ -116,6 +119,9 @@ SolutionQuality evaluateQuality(const RotationPairs& pairs, const Eigen::Matrix3
     }
     for (const auto& gp : g) model.G += gp * gp.transpose();
     model.noise_dims = 6.0 * used.size();
+    int poses_used = 0;
+    for (const auto& gp : g) poses_used += gp.isZero() ? 0 : 1;
+    independent_dof = std::min(independent_dof, 3.0 * poses_used - 3.0);
   } else {
     model.G = H;
     model.noise_dims = 3.0 * used.size();
@@ -128,7 +134,13 @@ SolutionQuality evaluateQuality(const RotationPairs& pairs, const Eigen::Matrix3
     const double dof = model.noise_dims - (H_inv * model.G).trace();
     if (dof > 0.5) {
       residual_var = sum_sq / dof;
-      q.covariance_rad2 = residual_var * H_inv * model.G * H_inv;
+      // The noise scale is itself estimated from few independent residual dimensions (n): the
+      // posterior of the error is then Student-t (Jeffreys prior on the scale), whose variance is
+      // n / (n - 2) times the plug-in one. Negligible for many poses; 1.5 for 3 poses (n = 6).
+      // Capped at 9 (3x on the sigma) where the t variance is infinite (n <= 2.25).
+      const double n = independent_dof;
+      const double t_factor = n > 2.25 ? n / (n - 2.0) : 9.0;
+      q.covariance_rad2 = t_factor * residual_var * H_inv * model.G * H_inv;
       for (int i = 0; i < 3; ++i) {
         q.std_dev_deg(i) =
             std::min(180.0, rad2deg(std::sqrt(std::max(0.0, q.covariance_rad2(i, i)))));
