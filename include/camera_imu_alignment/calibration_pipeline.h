@@ -80,7 +80,8 @@ struct PipelineSettings {
   double max_gyro_span_s = 120.0;     ///< longer motion between poses breaks the gyro chain
   double frame_queue_s = 3.0;         ///< frames older than the IMU by more are dropped (no IMU)
   double accel_weight = 0.9;          ///< attitudeFromAccelMag
-  /// Returns an empty string when usable, else the first unusable setting by name.
+  /// Returns an empty string when usable, else the first unusable setting, named by its key in
+  /// config/alignment.yaml.
   std::string validate() const;
 };
 
@@ -140,6 +141,7 @@ class CalibrationPipeline {
   void reset(bool clear_counts = false);
 
   const std::vector<StationaryPose>& poses() const;          ///< all poses so far
+  RotationPairs windowPairs() const;  ///< the pairs solve() uses (poses in the window)
   const std::vector<RejectedPose>& rejectedPoses() const;
   const std::vector<StationarySegment>& segments() const;    ///< all IMU rests so far
   const RejectionCounts& rejections() const;

@@ -1,0 +1,147 @@
+// Test harness: one simulated run (camera_imu_alignment_simulation) fed to a CalibrationPipeline
+// in stamp order, the way calibrate_bag and the nodelet feed it, without a bag.
+#pragma once
+
+#include <algorithm>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "camera_imu_alignment/calibration_pipeline.h"
+#include "camera_imu_alignment/simulation/renderer.h"
+#include "camera_imu_alignment/simulation/simulation_run.h"
+#include "camera_imu_alignment/simulation/target.h"
+#include "camera_imu_alignment/target_description.h"
+
+namespace camera_imu_alignment {
+namespace test {
+
+/// Bad samples injected by the harness (every n-th sample; 0 = none) and how many were sent.
+struct Injection {
+  int nan_imu_every = 0, duplicate_imu_every = 0, backwards_imu_every = 0;
+  int nan_mag_every = 0, gauss_mag_every = 0, empty_frame_every = 0;
+};
+struct Injected {
+  std::uint64_t nan_imu = 0, duplicate_imu = 0, backwards_imu = 0;
+  std::uint64_t nan_mag = 0, gauss_mag = 0, empty_frames = 0;
+};
+
+struct PipelineRun {
+  std::unique_ptr<simulation::SimulationRun> run;
+  std::unique_ptr<CalibrationPipeline> pipeline;
+  std::vector<AlignmentResult> results;  ///< every on_result, in order
+  std::vector<std::string> reject_details;  ///< on_reject details, first 200
+  Injected injected;
+  Eigen::Matrix3d R_cam_imu_true() const { return run->trajectory.R_cam_imu_final(); }
+};
+
+inline CameraIntrinsics simulatedIntrinsics(const simulation::SimulationConfig& c) {
+  CameraIntrinsics intrinsics;
+  intrinsics.width = c.width;
+  intrinsics.height = c.height;
+  intrinsics.K << c.fx, 0.0, c.cx, 0.0, c.fy, c.cy, 0.0, 0.0, 1.0;
+  intrinsics.distortion = CameraIntrinsics::Distortion::kPlumbBob;
+  intrinsics.D.assign(c.distortion.begin(), c.distortion.end());
+  return intrinsics;
+}
+
+inline bool every(std::size_t i, int n) { return n > 0 && i % n == static_cast<std::size_t>(n - 1); }
+
+/// Feeds a simulated run (possibly edited by the test) to a new pipeline: IMU, magnetometer and
+/// rendered frames merged in stamp order, with `injection` bad samples mixed in.
+inline PipelineRun feedPipeline(std::unique_ptr<simulation::SimulationRun> simulated,
+                                const PipelineSettings& settings,
+                                const Injection& injection = {}) {
+  namespace sim = simulation;
+  PipelineRun out;
+  out.run = std::move(simulated);
+  const sim::SimulationRun& run = *out.run;
+  const sim::SimulationConfig& c = run.config;
+  const TargetDescription target = parseTargetYaml(sim::targetYaml(c.target), "simulated target");
+  PipelineCallbacks callbacks;
+  std::vector<AlignmentResult>* results = &out.results;
+  callbacks.on_result = [results](const AlignmentResult& r) { results->push_back(r); };
+  std::vector<std::string>* details = &out.reject_details;
+  callbacks.on_reject = [details](RejectReason reason, const std::string& detail) {
+    if (details->size() < 200) details->push_back(std::string(rejectReasonName(reason)) + ": " + detail);
+  };
+  out.pipeline = std::make_unique<CalibrationPipeline>(target, settings, callbacks);
+  CalibrationPipeline& pipeline = *out.pipeline;
+  pipeline.setCameraIntrinsics(simulatedIntrinsics(c));
+  Injected& injected = out.injected;
+
+  const sim::ImageRenderer renderer(sim::CameraModel::fromConfig(c),
+                                    sim::makeTargetTexture(c.target, sim::textureTexelFor(c)),
+                                    c.supersample, c.blur_sigma_px);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::size_t next_imu = 0, next_mag = 0;
+  auto feedInertialUpTo = [&](double t) {
+    while (next_imu < run.imu.size() && run.imu[next_imu].t <= t) {
+      const std::size_t i = next_imu++;
+      const auto& s = run.imu[i];
+      if (every(i, injection.nan_imu_every)) {
+        pipeline.addImu({s.t, Eigen::Vector3d::Constant(nan), s.accel});
+        ++injected.nan_imu;
+        continue;
+      }
+      pipeline.addImu({s.t, s.gyro, s.accel});
+      if (every(i, injection.duplicate_imu_every)) {
+        pipeline.addImu({s.t, s.gyro, s.accel});
+        ++injected.duplicate_imu;
+      }
+      if (every(i, injection.backwards_imu_every)) {
+        pipeline.addImu({s.t - 0.5, s.gyro, s.accel});
+        ++injected.backwards_imu;
+      }
+    }
+    while (next_mag < run.mag.size() && run.mag[next_mag].t <= t) {
+      const std::size_t i = next_mag++;
+      const auto& s = run.mag[i];
+      if (every(i, injection.nan_mag_every)) {
+        pipeline.addMagnetic({s.t, Eigen::Vector3d(nan, 0.0, 0.0)});
+        ++injected.nan_mag;
+      } else if (every(i, injection.gauss_mag_every)) {
+        pipeline.addMagnetic({s.t, s.field * 1e4});  // gauss sent as tesla
+        ++injected.gauss_mag;
+      } else {
+        pipeline.addMagnetic({s.t, s.field});
+      }
+    }
+  };
+  int cached_pose = -1;
+  cv::Mat cached;
+  for (std::size_t j = 0; j < run.frame_times.size(); ++j) {
+    const double t = run.frame_times[j];
+    const double stamp = t + c.camera_time_offset_s;
+    feedInertialUpTo(stamp);
+    if (every(j, injection.empty_frame_every)) {
+      pipeline.addFrame({stamp, cv::Mat()});
+      ++injected.empty_frames;
+      continue;
+    }
+    const int pose = run.trajectory.at(t).pose;
+    cv::Mat grey;
+    if (pose >= 0) {
+      if (pose != cached_pose) cached = renderer.renderAt(run.trajectory, t);
+      cached_pose = pose;
+      grey = cached;
+    } else {
+      grey = renderer.renderAt(run.trajectory, t);
+    }
+    pipeline.addFrame({stamp, sim::ImageRenderer::toMono8(grey, c.noise_scale * c.pixel_noise_sigma,
+                                                          run.frameNoiseSeed(static_cast<long>(j)))});
+  }
+  feedInertialUpTo(std::numeric_limits<double>::infinity());
+  pipeline.finish();
+  return out;
+}
+
+/// Simulates `config` and feeds it to a new pipeline.
+inline PipelineRun runPipeline(const simulation::SimulationConfig& config,
+                               const PipelineSettings& settings = {},
+                               const Injection& injection = {}) {
+  return feedPipeline(std::make_unique<simulation::SimulationRun>(config), settings, injection);
+}
+
+}  // namespace test
+}  // namespace camera_imu_alignment

@@ -1,0 +1,396 @@
+// The calibration report: roll/pitch/yaw against analytic rotations, the export blocks parsed back
+// (Kalibr, OpenVINS, VINS, tf2) to 1e-8, the summary text, and the PNG page for realistic, empty
+// and NaN inputs.
+#include "camera_imu_alignment/calibration_report.h"
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <limits>
+#include <opencv2/imgcodecs.hpp>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "camera_imu_alignment/pose_window.h"
+#include "test_helpers.h"
+
+namespace camera_imu_alignment {
+namespace {
+
+using test::axisAngle;
+using test::randomRotation;
+
+constexpr double kRoundTrip = 1e-8;  // exported numbers parsed back, absolute
+constexpr double kDeg = test::kPiTest / 180.0;
+
+/// R = Rz(yaw) Ry(pitch) Rx(roll), angles in degrees, built with Eigen's AngleAxis.
+Eigen::Matrix3d fromRollPitchYawDeg(double roll, double pitch, double yaw) {
+  return (Eigen::AngleAxisd(yaw * kDeg, Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(pitch * kDeg, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(roll * kDeg, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Export blocks, parsed back
+// ---------------------------------------------------------------------------------------------
+
+/// The blank-line separated blocks of exportBlocks().
+std::vector<std::string> splitBlocks(const std::string& text) {
+  std::vector<std::string> blocks;
+  std::size_t begin = 0;
+  while (begin < text.size()) {
+    std::size_t end = text.find("\n\n", begin);
+    if (end == std::string::npos) end = text.size();
+    blocks.push_back(text.substr(begin, end - begin + 1));
+    begin = end + 2;
+  }
+  return blocks;
+}
+
+/// The block containing `key`; fails the test when there is not exactly one.
+std::string blockWith(const std::vector<std::string>& blocks, const std::string& key) {
+  std::string found;
+  int count = 0;
+  for (const std::string& b : blocks) {
+    if (b.find(key) != std::string::npos) {
+      found = b;
+      ++count;
+    }
+  }
+  EXPECT_EQ(count, 1) << key;
+  return found;
+}
+
+/// A YAML list of 4 lists of 4 numbers -> its top-left 3x3 block; checks the last row / column.
+Eigen::Matrix3d rotationOfTransform(const YAML::Node& T) {
+  EXPECT_TRUE(T.IsSequence());
+  EXPECT_EQ(T.size(), 4u);
+  Eigen::Matrix3d R = Eigen::Matrix3d::Constant(std::nan(""));
+  if (!T.IsSequence() || T.size() != 4) return R;
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(T[i].size(), 4u);
+    for (int k = 0; k < 4; ++k) {
+      const double value = T[i][k].as<double>();
+      if (i < 3 && k < 3) {
+        R(i, k) = value;
+      } else {
+        EXPECT_EQ(value, (i == 3 && k == 3) ? 1.0 : 0.0) << "row " << i << " col " << k;
+      }
+    }
+  }
+  return R;
+}
+
+Eigen::Matrix3d parseVinsRotation(const std::string& block) {
+  const YAML::Node node = YAML::Load(block)["extrinsicRotation"];
+  EXPECT_EQ(node.Tag(), "tag:yaml.org,2002:opencv-matrix");
+  EXPECT_EQ(node["rows"].as<int>(), 3);
+  EXPECT_EQ(node["cols"].as<int>(), 3);
+  EXPECT_EQ(node["dt"].as<std::string>(), "d");
+  EXPECT_EQ(node["data"].size(), 9u);
+  Eigen::Matrix3d R;
+  for (int i = 0; i < 9; ++i) R(i / 3, i % 3) = node["data"][i].as<double>();  // row-major
+  return R;
+}
+
+struct TfLine {
+  Eigen::Vector3d translation = Eigen::Vector3d::Constant(std::nan(""));
+  Eigen::Quaterniond q{std::nan(""), 0, 0, 0};
+  std::string parent, child;
+};
+
+TfLine parseTfLine(const std::string& block) {
+  static const std::regex kLine(
+      R"(rosrun tf2_ros static_transform_publisher (\S+) (\S+) (\S+) (\S+) (\S+) (\S+) (\S+) (\S+) (\S+)\n)");
+  std::smatch m;
+  TfLine tf;
+  EXPECT_TRUE(std::regex_search(block, m, kLine)) << block;
+  if (m.empty()) return tf;
+  tf.translation = Eigen::Vector3d(std::stod(m[1]), std::stod(m[2]), std::stod(m[3]));
+  tf.q = Eigen::Quaterniond(std::stod(m[7]), std::stod(m[4]), std::stod(m[5]), std::stod(m[6]));
+  tf.parent = m[8];
+  tf.child = m[9];
+  return tf;
+}
+
+void expectMatrixNear(const Eigen::Matrix3d& actual, const Eigen::Matrix3d& expected,
+                      const std::string& what) {
+  EXPECT_LE((actual - expected).cwiseAbs().maxCoeff(), kRoundTrip) << what << "\nactual\n"
+                                                                   << actual << "\nexpected\n"
+                                                                   << expected;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Inputs
+// ---------------------------------------------------------------------------------------------
+
+/// A recording of `num_poses` rests 10 s apart: camera and IMU orientations consistent with
+/// R_cam_imu (plus small noise), all pairs formed from them and solved; one rest rejected.
+ReportInput realisticInput(std::mt19937_64& rng, const Eigen::Matrix3d& R_cam_imu, int num_poses,
+                           double noise_rad) {
+  ReportInput in;
+  in.start_s = 1000.0;
+  in.end_s = 1000.0 + 10.0 * (num_poses + 2);
+  in.source = "/data/rig.bag";
+  std::vector<PoseOrientation> orientations;
+  const Eigen::Matrix3d R_target_world = randomRotation(rng);  // unknown in practice; cancels
+  for (int k = 0; k < num_poses; ++k) {
+    const Eigen::Matrix3d R_world_imu = randomRotation(rng);
+    PoseOrientation o;
+    o.stamp_s = in.start_s + 5.0 + 10.0 * k;
+    o.R_world_imu = R_world_imu * test::rotationFromVector(test::gaussianVector(rng, noise_rad));
+    o.R_target_cam = R_target_world * R_world_imu * R_cam_imu.transpose() *
+                     test::rotationFromVector(test::gaussianVector(rng, noise_rad));
+    orientations.push_back(o);
+    StationaryPose pose;
+    pose.index = k;
+    pose.start_s = o.stamp_s - 2.0;
+    pose.end_s = o.stamp_s + 2.0;
+    pose.R_target_cam = o.R_target_cam;
+    pose.R_world_imu = o.R_world_imu;
+    in.poses.push_back(pose);
+    StationarySegment segment;
+    segment.start_s = pose.start_s - 0.5;
+    segment.end_s = pose.end_s + 0.5;
+    in.segments.push_back(segment);
+  }
+  RejectedPose rejected;
+  rejected.start_s = in.start_s + 5.0 + 10.0 * num_poses - 3.0;
+  rejected.end_s = rejected.start_s + 6.0;
+  rejected.reason = "target seen in 1 frame (2 needed)";
+  in.rejected.push_back(rejected);
+  in.segments.push_back({});
+  in.segments.back().start_s = rejected.start_s;
+  in.segments.back().end_s = rejected.end_s;
+  in.rejections.add(RejectReason::kTargetNotFound, 7);
+  in.rejections.add(RejectReason::kStampBackwards);
+  in.pairs = makeAllPairs(orientations);
+  in.result = solveAlignment(in.pairs);
+  return in;
+}
+
+/// Everything empty or NaN, start_s == end_s.
+ReportInput degenerateInput() {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  ReportInput in;
+  in.start_s = in.end_s = 42.0;
+  SolutionQuality& q = in.result.quality;
+  q.residual_rms_deg = nan;
+  q.observability = nan;
+  q.weakest_excitation_deg = nan;
+  q.std_dev_deg = Eigen::Vector3d::Constant(nan);
+  q.weak_axis_cam = Eigen::Vector3d::Constant(nan);
+  q.excite_axis_cam = Eigen::Vector3d::Constant(nan);
+  q.covariance_rad2 = Eigen::Matrix3d::Constant(nan);
+  PairDiagnostics p;
+  p.residual_deg = nan;
+  q.pairs = {p, p};
+  q.num_pairs = 2;
+  in.pairs = {RotationPair{}, RotationPair{}};  // zero rotations: no axis
+  in.pairs[1].A_cam = Eigen::Matrix3d::Constant(nan);
+  in.segments.push_back({});
+  in.segments.back().start_s = nan;
+  in.segments.push_back({});
+  in.segments.back().start_s = -std::numeric_limits<double>::infinity();
+  in.segments.back().end_s = std::numeric_limits<double>::infinity();
+  in.rejected.push_back({nan, 42.0, ""});
+  StationaryPose reversed;
+  reversed.start_s = 50.0;
+  reversed.end_s = 10.0;
+  in.poses.push_back(reversed);
+  return in;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Tests
+// ---------------------------------------------------------------------------------------------
+
+TEST(RollPitchYaw, MatchesAnalyticRotations) {
+  const double values[][3] = {{0, 0, 0},       {10, 0, 0},      {0, 20, 0},     {0, 0, 30},
+                              {-15, 25, -160}, {170, -80, 5},   {-179, 45, 90}, {33.3, -12.5, -90},
+                              {-90, 89, 179},  {120, -60, -120}};
+  for (const auto& v : values) {
+    const Eigen::Vector3d rpy = rollPitchYawDeg(fromRollPitchYawDeg(v[0], v[1], v[2]));
+    EXPECT_NEAR(rpy(0), v[0], 1e-9) << v[0] << " " << v[1] << " " << v[2];
+    EXPECT_NEAR(rpy(1), v[1], 1e-9) << v[0] << " " << v[1] << " " << v[2];
+    EXPECT_NEAR(rpy(2), v[2], 1e-9) << v[0] << " " << v[1] << " " << v[2];
+  }
+}
+
+TEST(RollPitchYaw, RebuildsRandomRotationsAndGimbalLock) {
+  std::mt19937_64 rng(11);
+  std::vector<Eigen::Matrix3d> rotations = {fromRollPitchYawDeg(30, 90, 40),
+                                            fromRollPitchYawDeg(-20, -90, 10)};
+  for (int i = 0; i < 50; ++i) rotations.push_back(randomRotation(rng));
+  for (const Eigen::Matrix3d& R : rotations) {
+    const Eigen::Vector3d rpy = rollPitchYawDeg(R);
+    EXPECT_LE(std::abs(rpy(1)), 90.0);
+    EXPECT_ROTATION_NEAR_DEG(fromRollPitchYawDeg(rpy(0), rpy(1), rpy(2)), R, 1e-6);
+  }
+}
+
+TEST(ExportBlocks, EveryBlockRoundTripsToTheRotation) {
+  std::mt19937_64 rng(12);
+  std::vector<Eigen::Matrix3d> rotations = {
+      Eigen::Matrix3d::Identity(), axisAngle(Eigen::Vector3d(1, -2, 0.5), test::kPiTest),
+      axisAngle(Eigen::Vector3d(0, 0, 1), 1e-7), fromRollPitchYawDeg(-90, 0, -90)};
+  for (int i = 0; i < 20; ++i) rotations.push_back(randomRotation(rng));
+  for (const Eigen::Matrix3d& R_cam_imu : rotations) {
+    const std::string text = exportBlocks(R_cam_imu, "cam_optical", "imu_link");
+    const std::vector<std::string> blocks = splitBlocks(text);
+    ASSERT_EQ(blocks.size(), 4u) << text;
+    for (const std::string& b : blocks) EXPECT_EQ(b.rfind("# ", 0), 0u) << "comment first:\n" << b;
+
+    const YAML::Node kalibr = YAML::Load(blockWith(blocks, "Kalibr"));
+    expectMatrixNear(rotationOfTransform(kalibr["cam0"]["T_cam_imu"]), R_cam_imu, "Kalibr");
+
+    const YAML::Node openvins = YAML::Load(blockWith(blocks, "OpenVINS"));
+    expectMatrixNear(rotationOfTransform(openvins["cam0"]["T_imu_cam"]), R_cam_imu.transpose(),
+                     "OpenVINS");
+
+    expectMatrixNear(parseVinsRotation(blockWith(blocks, "VINS-Mono")), R_cam_imu.transpose(),
+                     "VINS extrinsicRotation");
+
+    const TfLine tf = parseTfLine(blockWith(blocks, "static_transform_publisher"));
+    EXPECT_EQ(tf.translation, Eigen::Vector3d::Zero());
+    EXPECT_NEAR(tf.q.norm(), 1.0, kRoundTrip);
+    // Sign-agnostic: q and -q give the same matrix.
+    expectMatrixNear(tf.q.normalized().toRotationMatrix(), R_cam_imu, "tf quaternion");
+    EXPECT_EQ(tf.parent, "cam_optical");
+    EXPECT_EQ(tf.child, "imu_link");
+  }
+}
+
+TEST(FormatSummary, ShowsStatusNumbersRejectionsAndEndsWithTheBlocks) {
+  std::mt19937_64 rng(13);
+  const Eigen::Matrix3d R_cam_imu = randomRotation(rng);
+  const ReportInput in = realisticInput(rng, R_cam_imu, 8, 0.002);
+  ASSERT_EQ(in.result.status, SolveStatus::kOk) << in.result.message;
+  EXPECT_ROTATION_NEAR_DEG(in.result.R_cam_imu, R_cam_imu, 1.0);
+
+  const std::string text = formatSummary(in);
+  const std::string blocks = exportBlocks(in.result.R_cam_imu, in.camera_frame, in.imu_frame);
+  ASSERT_GE(text.size(), blocks.size());
+  EXPECT_EQ(text.substr(text.size() - blocks.size()), blocks);
+  EXPECT_NE(text.find("status: ok"), std::string::npos) << text;
+  EXPECT_NE(text.find(in.source), std::string::npos);
+  EXPECT_EQ(text.find("WARNING"), std::string::npos);
+
+  std::ostringstream rpy;
+  const Eigen::Vector3d angles = rollPitchYawDeg(in.result.R_cam_imu);
+  rpy << std::fixed << std::setprecision(4) << "[" << angles(0) << ", " << angles(1) << ", "
+      << angles(2) << "]";
+  EXPECT_NE(text.find(rpy.str()), std::string::npos) << rpy.str() << "\n" << text;
+  std::ostringstream rms;
+  rms << std::fixed << std::setprecision(4) << in.result.quality.residual_rms_deg;
+  EXPECT_NE(text.find("residual RMS (deg): " + rms.str()), std::string::npos) << text;
+  EXPECT_NE(text.find("poses used: 8"), std::string::npos) << text;
+  EXPECT_NE(text.find("target seen in 1 frame (2 needed)"), std::string::npos) << text;
+  EXPECT_NE(text.find("target_not_found: 7"), std::string::npos) << text;
+  EXPECT_NE(text.find("stamp_backwards: 1"), std::string::npos) << text;
+}
+
+TEST(FormatSummary, NotObservableNamesTheAxisAndWarnsAboveTheBlocks) {
+  std::mt19937_64 rng(14);
+  const Eigen::Matrix3d R_cam_imu = randomRotation(rng);
+  ReportInput in;
+  const Eigen::Vector3d axis_imu = R_cam_imu.transpose() * Eigen::Vector3d::UnitY();
+  for (double angle : {0.4, 0.9, 1.5, -0.7}) {
+    in.pairs.push_back(test::exactPair(R_cam_imu, axisAngle(axis_imu, angle)));
+  }
+  in.result = solveAlignment(in.pairs);
+  ASSERT_EQ(in.result.status, SolveStatus::kNotObservable);
+  const std::string text = formatSummary(in);
+  EXPECT_NE(text.find("status: not observable"), std::string::npos) << text;
+  EXPECT_NE(text.find("observable: NO"), std::string::npos) << text;
+  EXPECT_NE(text.find("constrain the rotation about camera y"), std::string::npos) << text;
+  EXPECT_LT(text.find("WARNING"), text.find("# Kalibr"));
+}
+
+TEST(FormatSummary, NanFieldsPrintNa) {
+  const std::string text = formatSummary(degenerateInput());
+  EXPECT_NE(text.find("n/a"), std::string::npos) << text;
+  EXPECT_EQ(text.find("nan"), std::string::npos) << text;
+  EXPECT_NE(text.find("status: bad input"), std::string::npos) << text;
+}
+
+/// Count of pixels equal to `bgr`.
+int countColour(const cv::Mat& img, const cv::Vec3b& bgr) {
+  int n = 0;
+  for (int r = 0; r < img.rows; ++r) {
+    for (int c = 0; c < img.cols; ++c) n += img.at<cv::Vec3b>(r, c) == bgr;
+  }
+  return n;
+}
+
+TEST(RenderReport, RealisticInputDrawsAPageWithOutliersInRed) {
+  std::mt19937_64 rng(15);
+  const Eigen::Matrix3d R_cam_imu = randomRotation(rng);
+  ReportInput in = realisticInput(rng, R_cam_imu, 10, 0.002);
+  in.pairs.push_back(test::exactPair(randomRotation(rng), randomRotation(rng)));  // gross outlier
+  in.result = solveAlignment(in.pairs);
+  ASSERT_EQ(in.result.status, SolveStatus::kOk) << in.result.message;
+  ASSERT_EQ(in.result.quality.pairs.size(), in.pairs.size());
+  ASSERT_FALSE(in.result.quality.pairs.back().inlier);
+
+  const cv::Mat img = renderReport(in);
+  ASSERT_FALSE(img.empty());
+  EXPECT_EQ(img.type(), CV_8UC3);
+  EXPECT_EQ(img.cols, 1200);
+  EXPECT_EQ(img.rows, 900);
+  EXPECT_GT(countColour(img, {30, 30, 220}), 50);    // outlier bar, rejected rest
+  EXPECT_GT(countColour(img, {40, 160, 40}), 200);   // accepted poses
+  EXPECT_GT(countColour(img, {200, 110, 30}), 200);  // inlier bars, axis points
+}
+
+TEST(RenderReport, EmptyAndNanInputsDrawWithoutCrashing) {
+  for (const ReportInput& in : {ReportInput{}, degenerateInput()}) {
+    const cv::Mat img = renderReport(in);
+    ASSERT_FALSE(img.empty());
+    EXPECT_EQ(img.type(), CV_8UC3);
+    EXPECT_GT(img.total(), 0u);
+  }
+}
+
+TEST(RenderReport, NonFiniteOrHugeRecordingSpansDrawWithoutCrashing) {
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const auto& [start, end] : std::vector<std::pair<double, double>>{
+           {-inf, inf}, {1e300, -1e300}, {1e308, 1e308}, {0.0, 1e-300}, {-1e308, 1e308}}) {
+    ReportInput in = degenerateInput();
+    in.start_s = start;
+    in.end_s = end;
+    const cv::Mat img = renderReport(in);
+    EXPECT_EQ(img.type(), CV_8UC3) << start << " " << end;
+    EXPECT_FALSE(formatSummary(in).empty());
+  }
+}
+
+TEST(WriteReportPng, WritesAReadablePngAndReportsUnwritablePaths) {
+  std::mt19937_64 rng(16);
+  const ReportInput in = realisticInput(rng, randomRotation(rng), 6, 0.001);
+  const std::string path = test::processTempDir() + "report.png";
+  std::string error;
+  ASSERT_TRUE(writeReportPng(path, in, &error)) << error;
+  const cv::Mat read = cv::imread(path);
+  ASSERT_FALSE(read.empty());
+  const cv::Mat expected = renderReport(in);
+  EXPECT_EQ(read.size(), expected.size());
+  EXPECT_EQ(read.type(), CV_8UC3);
+  EXPECT_EQ(cv::norm(read, expected, cv::NORM_INF), 0.0);  // PNG is lossless
+
+  error.clear();
+  EXPECT_FALSE(writeReportPng("/nonexistent_dir/x.png", in, &error));
+  EXPECT_FALSE(error.empty());
+  EXPECT_NE(error.find("/nonexistent_dir"), std::string::npos) << error;
+  error.clear();
+  EXPECT_FALSE(writeReportPng(test::processTempDir() + "report.unknown_extension", in, &error));
+  EXPECT_FALSE(error.empty());
+}
+
+}  // namespace
+}  // namespace camera_imu_alignment
