@@ -109,8 +109,8 @@ TEST(SimulateBag, FilesTopicsCountsAndRates) {
     double rate;
   } expected[] = {{"imu/data_raw", "sensor_msgs/Imu", "imu", 200.0},
                   {"imu/mag", "sensor_msgs/MagneticField", "magnetometer", 100.0},
-                  {"camera/image_raw", "sensor_msgs/Image", "images", 5.0},
-                  {"camera/camera_info", "sensor_msgs/CameraInfo", "images", 5.0}};
+                  {"camera/image_raw", "sensor_msgs/Image", "images", 15.0},
+                  {"camera/camera_info", "sensor_msgs/CameraInfo", "images", 15.0}};
   for (const auto& e : expected) {
     ASSERT_TRUE(topics.count(e.topic)) << e.topic << "\n" << info.out;
     const YAML::Node& n = topics[e.topic];

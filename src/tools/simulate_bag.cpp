@@ -98,7 +98,7 @@ std::string usage() {
        "  --motion full|single_axis|small_angle   --max-tilt-deg (35)   --max-roll-deg (80)\n"
        "  --r-cam-imu qx,qy,qz,qw (random per seed)   --remount [--remount-time-s T] "
        "[--remount-deg x,y,z (0,10,0)]\n"
-       "  --imu-rate-hz (200)  --mag-rate-hz (100)  --camera-rate-hz (5)  --noise-scale (1)\n"
+       "  --imu-rate-hz (200)  --mag-rate-hz (100)  --camera-rate-hz (15)  --noise-scale (1)\n"
        "  --gyro-noise-density (1.87e-4)  --gyro-random-walk (2.66e-5)  --accel-noise-density "
        "(1.86e-3)\n"
        "  --accel-random-walk (4.33e-4)  --mag-noise-ut (0.3)  --earth-field-ut x,y,z "

@@ -1,0 +1,33 @@
+// ROS messages -> the core library's plain structs. The only place where sensor_msgs meet the
+// core; used by calibrate_bag and the nodelet, so both feed the pipeline identically.
+// Nothing here validates values (NaN, zero vectors, stamps): the pipeline does, and counts.
+#pragma once
+
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/Imu.h>
+#include <sensor_msgs/MagneticField.h>
+
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "camera_imu_alignment/camera_model.h"
+#include "camera_imu_alignment/inertial_samples.h"
+
+namespace camera_imu_alignment {
+
+/// Header stamp (s), gyro (rad/s), accelerometer (m/s^2). The orientation field is ignored.
+ImuSample toImuSample(const sensor_msgs::Imu& msg);
+/// Header stamp (s) and field (as sent; nominally tesla).
+MagneticSample toMagneticSample(const sensor_msgs::MagneticField& msg);
+/// K, D, distortion_model, size; false with `error` when unusable (zero K, wrong D length, ...).
+bool toCameraIntrinsics(const sensor_msgs::CameraInfo& msg, CameraIntrinsics* intrinsics,
+                        std::string* error);
+/// mono8 / 8UC1 (shared), mono16 / 16UC1 (scaled so that the brightest pixel is 255: 10/12-bit data too), rgb8, bgr8, rgba8, bgra8 (to grey).
+/// False with `error` for other encodings or when step/size/data length disagree.
+bool toMono8(const sensor_msgs::Image& msg, cv::Mat* mono8, std::string* error);
+/// JPEG/PNG payload of a CompressedImage (any format cv::imdecode reads), decoded to grey.
+bool toMono8(const sensor_msgs::CompressedImage& msg, cv::Mat* mono8, std::string* error);
+
+}  // namespace camera_imu_alignment

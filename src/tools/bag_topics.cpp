@@ -1,0 +1,107 @@
+#include "bag_topics.h"
+
+#include <rosbag/view.h>
+
+#include <map>
+#include <stdexcept>
+#include <vector>
+
+namespace camera_imu_alignment {
+namespace {
+
+const char* kImu = "sensor_msgs/Imu";
+const char* kMag = "sensor_msgs/MagneticField";
+const char* kImage = "sensor_msgs/Image";
+const char* kCompressed = "sensor_msgs/CompressedImage";
+const char* kInfo = "sensor_msgs/CameraInfo";
+
+std::string normalise(std::string topic) {
+  if (!topic.empty() && topic[0] != '/') topic = "/" + topic;
+  return topic;
+}
+
+std::string list(const std::vector<std::string>& topics) {
+  std::string out;
+  for (const auto& t : topics) out += (out.empty() ? "" : ", ") + t;
+  return out;
+}
+
+/// The topic of `type`: the requested one (checked) or the only one in the bag.
+std::string pick(const std::map<std::string, std::string>& types, const std::string& requested,
+                 const std::vector<std::string>& wanted_types, const char* what, bool required,
+                 const char* option) {
+  if (!requested.empty()) {
+    // "imu" and "/imu" name the same topic; bags store whichever the recorder used.
+    auto it = types.find(requested);
+    for (auto c = types.begin(); it == types.end() && c != types.end(); ++c) {
+      if (normalise(c->first) == normalise(requested)) it = c;
+    }
+    if (it == types.end()) {
+      throw std::runtime_error(std::string(option) + " " + requested + ": no such topic in the bag");
+    }
+    for (const auto& t : wanted_types) {
+      if (it->second == t) return it->first;
+    }
+    throw std::runtime_error(std::string(option) + " " + requested + ": topic has type " +
+                             it->second + ", " + what + " needs " + list(wanted_types));
+  }
+  std::vector<std::string> candidates;
+  for (const auto& [topic, type] : types) {
+    for (const auto& t : wanted_types) {
+      if (type == t) candidates.push_back(topic);
+    }
+  }
+  if (candidates.size() > 1) {
+    throw std::runtime_error(std::string("several ") + what + " topics in the bag (" +
+                             list(candidates) + "): choose one with " + option);
+  }
+  if (candidates.empty()) {
+    if (required) {
+      throw std::runtime_error(std::string("no ") + what + " topic (" + list(wanted_types) +
+                               ") in the bag");
+    }
+    return "";
+  }
+  return candidates.front();
+}
+
+}  // namespace
+
+BagTopics selectBagTopics(const rosbag::Bag& bag, const BagTopics& requested) {
+  std::map<std::string, std::string> types;
+  rosbag::View view(bag);
+  for (const rosbag::ConnectionInfo* c : view.getConnections()) types[c->topic] = c->datatype;
+
+  BagTopics topics;
+  topics.imu = pick(types, requested.imu, {kImu}, "IMU", true, "--imu-topic");
+  topics.mag = pick(types, requested.mag, {kMag}, "magnetometer", false, "--mag-topic");
+  // Images: a raw and a compressed topic of the same camera are common; prefer the raw one.
+  if (requested.image.empty()) {
+    topics.image = pick(types, "", {kImage}, "image", false, "--image-topic");
+    if (topics.image.empty()) {
+      topics.image = pick(types, "", {kCompressed}, "image", false, "--image-topic");
+    }
+  } else {
+    topics.image = pick(types, requested.image, {kImage, kCompressed}, "image", true,
+                        "--image-topic");
+  }
+  topics.image_compressed = !topics.image.empty() && types[topics.image] == kCompressed;
+  // Camera info: the one next to the image topic when there are several.
+  if (requested.camera_info.empty() && !topics.image.empty()) {
+    std::string base = topics.image;
+    if (topics.image_compressed && base.size() > 11 &&
+        base.compare(base.size() - 11, 11, "/compressed") == 0) {
+      base.resize(base.size() - 11);
+    }
+    const std::string sibling = base.substr(0, base.find_last_of('/')) + "/camera_info";
+    if (types.count(sibling) && types[sibling] == kInfo) {
+      topics.camera_info = sibling;
+      return topics;
+    }
+  }
+  topics.camera_info =
+      pick(types, requested.camera_info, {kInfo}, "camera info", false, "--camera-info-topic");
+  return topics;
+}
+
+}  // namespace camera_imu_alignment

@@ -1,0 +1,338 @@
+// calibrate_bag: R_cam_imu from a rosbag of a camera + IMU (+ magnetometer) rig, offline, without a
+// roscore. Reads the bag with the rosbag C++ API and drives the core CalibrationPipeline (the same
+// class the nodelet drives). Exit codes (shared/CONVENTIONS.md): 0 success; 2 bad input or usage
+// (unreadable or truncated bag, missing topic, no camera data, bad target file); 3 not enough
+// information (too few poses, not observable: the message names the axis to rotate about).
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include "bag_topics.h"
+#include "camera_imu_alignment/calibration_pipeline.h"
+#include "camera_imu_alignment/calibration_report.h"
+#include "camera_imu_alignment/csv_io.h"
+#include "camera_imu_alignment/pipeline_config.h"
+#include "camera_imu_alignment/result_yaml.h"
+#include "camera_imu_alignment/rotation_math.h"
+#include "camera_imu_alignment/ros/message_conversion.h"
+#include "camera_imu_alignment/target_description.h"
+#include "cli_args.h"
+
+namespace cia = camera_imu_alignment;
+
+namespace {
+
+constexpr int kExitOk = 0;
+constexpr int kExitBadInput = 2;
+constexpr int kExitNotEnough = 3;
+
+const char* kUsage =
+    "usage: calibrate_bag --bag FILE.bag --target TARGET.yaml [--config PARAMS.yaml]\n"
+    "                     [--imu-topic T] [--mag-topic T] [--image-topic T]\n"
+    "                     [--camera-info-topic T] [--method optimal|two_step]\n"
+    "                     [--imu-orientation auto|magnetometer] [--output RESULT.yaml]\n"
+    "                     [--report REPORT.png] [--truth TRUTH.yaml] [--quiet]\n"
+    "  --bag FILE.bag        ROS 1 bag: sensor_msgs/Imu, optional MagneticField, Image or\n"
+    "                        CompressedImage and CameraInfo (topics found by type when not given)\n"
+    "  --target TARGET.yaml  Kalibr target file (checkerboard, aprilgrid, circlegrid)\n"
+    "  --config PARAMS.yaml  settings, keys as in config/alignment.yaml\n"
+    "  --method M            optimal (default) or two_step (the paper's iteration alone)\n"
+    "  --imu-orientation S   auto (default: gyro between poses) or magnetometer (the paper's)\n"
+    "  --output RESULT.yaml  write the result YAML (shared/CONVENTIONS.md) there\n"
+    "  --report REPORT.png   write a one-page report: residuals, axis coverage, rests, estimate\n"
+    "  --truth TRUTH.yaml    a YAML with R_cam_imu (e.g. simulate_bag's) to print the error to\n"
+    "  --quiet               no progress on stderr\n"
+    "exit codes: 0 success, 2 bad input or usage, 3 not enough information (the message says what\n"
+    "motion is missing)\n";
+
+/// Progress on stderr: a live line on a terminal, plain lines every 10% otherwise.
+class Progress {
+ public:
+  Progress(bool enabled, double start_s, double end_s)
+      : enabled_(enabled), tty_(isatty(fileno(stderr))), start_(start_s), end_(end_s) {}
+  void update(double t, const cia::CalibrationPipeline& pipeline, bool force = false) {
+    if (!enabled_) return;
+    const double span = end_ - start_;
+    const int percent = span > 0.0 ? static_cast<int>(100.0 * (t - start_) / span) : 100;
+    const int step = tty_ ? 1 : 10;
+    if (!force && percent / step == last_ / step) return;
+    last_ = percent;
+    std::ostringstream line;
+    line << "[calibrate_bag] " << std::setw(3) << std::min(percent, 100) << "% of bag time, "
+         << pipeline.segments().size() << " rests, " << pipeline.poses().size() << " poses";
+    if (const auto result = pipeline.lastResult()) {
+      const Eigen::Vector3d rpy = cia::rollPitchYawDeg(result->R_cam_imu);
+      line << std::fixed << std::setprecision(2) << ", R_cam_imu rpy [" << rpy.x() << ", "
+           << rpy.y() << ", " << rpy.z() << "] deg +- " << result->quality.std_dev_deg.maxCoeff();
+    }
+    if (tty_) {
+      std::cerr << "\r\033[K" << line.str() << std::flush;
+    } else {
+      std::cerr << line.str() << "\n";
+    }
+  }
+  void done() {
+    if (enabled_ && tty_) std::cerr << "\n";
+  }
+
+ private:
+  bool enabled_, tty_;
+  double start_, end_;
+  int last_ = -100;
+};
+
+/// Prints the first few rejections of each reason, then only counts (summary at the end).
+class RejectLog {
+ public:
+  void operator()(cia::RejectReason reason, const std::string& detail) {
+    const int n = ++shown_[reason];
+    if (n <= 3) std::cerr << "[calibrate_bag] rejected: " << detail << "\n";
+    if (n == 3) {
+      std::cerr << "[calibrate_bag] (further '" << cia::rejectReasonName(reason)
+                << "' rejections are counted, not shown)\n";
+    }
+  }
+
+ private:
+  std::map<cia::RejectReason, int> shown_;
+};
+
+/// Keys of config/alignment.yaml that only the ROS wrapper reads (topics, frames, files).
+const std::vector<std::string> kRosOnlyKeys = {
+    "camera_frame", "imu_frame", "publish_inverse", "output_file", "target_file", "manual_capture",
+    "min_pose_change_deg", "max_residual_deg", "max_std_dev_deg", "remount_poses",
+    "remount_threshold_deg", "status_rate_hz"};
+
+std::string stripSlash(const std::string& frame) {
+  return !frame.empty() && frame[0] == '/' ? frame.substr(1) : frame;
+}
+
+struct RunInfo {
+  std::string camera_frame, imu_frame;
+  std::uint64_t image_messages = 0, info_messages = 0;
+  double start_s = 0.0, end_s = 0.0;
+};
+
+/// Feeds every message of the selected topics to the pipeline. Throws rosbag exceptions on a
+/// corrupt or truncated bag.
+void readBag(const rosbag::Bag& bag, const cia::BagTopics& topics, cia::CalibrationPipeline* pipeline,
+             Progress* progress, RunInfo* info) {
+  std::vector<std::string> names = {topics.imu};
+  for (const auto& t : {topics.mag, topics.image, topics.camera_info}) {
+    if (!t.empty()) names.push_back(t);
+  }
+  rosbag::View view(bag, rosbag::TopicQuery(names));
+  bool have_info = false;
+  for (const rosbag::MessageInstance& m : view) {
+    const std::string& topic = m.getTopic();
+    if (topic == topics.imu) {
+      const auto msg = m.instantiate<sensor_msgs::Imu>();
+      if (!msg) continue;
+      if (info->imu_frame.empty()) info->imu_frame = stripSlash(msg->header.frame_id);
+      pipeline->addImu(cia::toImuSample(*msg));
+    } else if (topic == topics.mag) {
+      if (const auto msg = m.instantiate<sensor_msgs::MagneticField>()) {
+        pipeline->addMagnetic(cia::toMagneticSample(*msg));
+      }
+    } else if (topic == topics.camera_info) {
+      ++info->info_messages;
+      const auto msg = m.instantiate<sensor_msgs::CameraInfo>();
+      if (!msg || (have_info && pipeline->hasIntrinsics())) continue;  // constant per camera
+      cia::CameraIntrinsics intrinsics;
+      std::string error;
+      if (!cia::toCameraIntrinsics(*msg, &intrinsics, &error)) {
+        std::cerr << "[calibrate_bag] " << topics.camera_info << ": " << error << "\n";
+        continue;
+      }
+      have_info = pipeline->setCameraIntrinsics(intrinsics);
+    } else if (topic == topics.image) {
+      ++info->image_messages;
+      cia::CameraFrame frame;
+      std::string error, frame_id;
+      bool ok = false;
+      if (topics.image_compressed) {
+        if (const auto msg = m.instantiate<sensor_msgs::CompressedImage>()) {
+          frame.stamp_s = msg->header.stamp.toSec();
+          frame_id = msg->header.frame_id;
+          ok = cia::toMono8(*msg, &frame.mono8, &error);
+        }
+      } else if (const auto msg = m.instantiate<sensor_msgs::Image>()) {
+        frame.stamp_s = msg->header.stamp.toSec();
+        frame_id = msg->header.frame_id;
+        ok = cia::toMono8(*msg, &frame.mono8, &error);
+      }
+      if (info->camera_frame.empty()) info->camera_frame = stripSlash(frame_id);
+      if (!ok) frame.mono8.release();  // counted as a bad image by the pipeline
+      if (!ok && !error.empty()) {
+        static int shown = 0;
+        if (++shown <= 3) std::cerr << "[calibrate_bag] " << topics.image << ": " << error << "\n";
+      }
+      pipeline->addFrame(frame);
+    }
+    progress->update(m.getTime().toSec(), *pipeline);
+  }
+  pipeline->finish();
+  progress->update(info->end_s, *pipeline, true);
+  progress->done();
+}
+
+
+/// The whole job; returns the exit code.
+int run(const cia::CliArgs& args) {
+  // --- Inputs: target, settings, bag, topics. Each failure names its file, option or topic.
+  cia::TargetDescription target;
+  cia::PipelineSettings settings;
+  try {
+    target = cia::loadTargetYaml(args.get("--target"));
+    if (args.has("--config")) cia::loadPipelineConfig(args.get("--config"), &settings, kRosOnlyKeys);
+  } catch (const cia::InputError& e) {
+    std::cerr << "calibrate_bag: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  if (args.has("--method") && !cia::parseSolverMethod(args.get("--method"), &settings.solver.method)) {
+    std::cerr << "calibrate_bag: --method " << args.get("--method")
+              << ": must be optimal or two_step\n";
+    return kExitBadInput;
+  }
+  if (args.has("--imu-orientation") &&
+      !cia::parseImuOrientationSource(args.get("--imu-orientation"), &settings.imu_orientation)) {
+    std::cerr << "calibrate_bag: --imu-orientation " << args.get("--imu-orientation")
+              << ": must be auto or magnetometer\n";
+    return kExitBadInput;
+  }
+  std::optional<cia::StoredCalibration> truth;
+  if (args.has("--truth")) {
+    try {
+      truth = cia::readResultYaml(args.get("--truth"));
+    } catch (const cia::InputError& e) {
+      std::cerr << "calibrate_bag: " << e.what() << "\n";
+      return kExitBadInput;
+    }
+  }
+  const std::string bag_path = args.get("--bag");
+  rosbag::Bag bag;
+  cia::BagTopics topics;
+  RunInfo info;
+  try {
+    bag.open(bag_path, rosbag::bagmode::Read);
+    cia::BagTopics requested{args.get("--imu-topic"), args.get("--mag-topic"),
+                             args.get("--image-topic"), false, args.get("--camera-info-topic")};
+    topics = cia::selectBagTopics(bag, requested);
+    rosbag::View all(bag);
+    info.start_s = all.getBeginTime().toSec();
+    info.end_s = all.getEndTime().toSec();
+  } catch (const std::exception& e) {
+    std::cerr << "calibrate_bag: " << bag_path << ": " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  std::cerr << "[calibrate_bag] " << bag_path << ": IMU " << topics.imu << ", magnetometer "
+            << (topics.mag.empty() ? "(none)" : topics.mag) << ", images "
+            << (topics.image.empty() ? "(none)" : topics.image) << ", camera info "
+            << (topics.camera_info.empty() ? "(none)" : topics.camera_info) << "; target "
+            << target.describe() << "\n";
+
+  // --- Run the pipeline over the bag.
+  RejectLog reject_log;
+  cia::PipelineCallbacks callbacks;
+  callbacks.on_reject = [&](cia::RejectReason r, const std::string& d) { reject_log(r, d); };
+  cia::CalibrationPipeline pipeline(target, settings, callbacks);
+  Progress progress(!args.has("--quiet"), info.start_s, info.end_s);
+  try {
+    readBag(bag, topics, &pipeline, &progress, &info);
+  } catch (const std::exception& e) {
+    progress.done();
+    std::cerr << "calibrate_bag: " << bag_path << ": cannot read the bag to the end ("
+              << e.what() << "); truncated or corrupt? 'rosbag reindex' may repair it\n";
+    return kExitBadInput;
+  }
+
+  // --- Verdict.
+  std::cerr << "[calibrate_bag] read " << pipeline.imuSamples() << " IMU, "
+            << pipeline.magneticSamples() << " magnetometer samples, " << info.image_messages
+            << " images; " << pipeline.segments().size() << " stationary rests, "
+            << pipeline.poses().size() << " poses\n";
+  if (topics.image.empty() || info.image_messages == 0) {
+    std::cerr << "calibrate_bag: " << bag_path << ": no camera data (no sensor_msgs/Image or "
+              << "CompressedImage messages); the IMU alone cannot give R_cam_imu\n";
+    return kExitBadInput;
+  }
+  if (!pipeline.hasIntrinsics()) {
+    std::cerr << "calibrate_bag: " << bag_path << ": no usable camera info ("
+              << (topics.camera_info.empty() ? "no sensor_msgs/CameraInfo topic" : topics.camera_info)
+              << "); PnP needs the intrinsics\n";
+    return kExitBadInput;
+  }
+  cia::ReportInput report;
+  report.result = pipeline.solve();
+  report.poses = pipeline.poses();
+  report.rejected = pipeline.rejectedPoses();
+  report.segments = pipeline.segments();
+  report.rejections = pipeline.rejections();
+  report.start_s = info.start_s;
+  report.end_s = info.end_s;
+  report.camera_frame = info.camera_frame.empty() ? "camera_optical_frame" : info.camera_frame;
+  report.imu_frame = info.imu_frame.empty() ? "imu_link" : info.imu_frame;
+  report.source = bag_path;
+  report.pairs = pipeline.windowPairs();
+  std::cout << cia::formatSummary(report);
+  if (truth) {
+    std::cout << std::fixed << std::setprecision(4) << "error to " << args.get("--truth") << ": "
+              << cia::rad2deg(cia::geodesicDistance(report.result.R_cam_imu, truth->R_cam_imu))
+              << " deg\n";
+  }
+  if (args.has("--report")) {
+    std::string error;
+    if (!cia::writeReportPng(args.get("--report"), report, &error)) {
+      std::cerr << "calibrate_bag: --report " << args.get("--report") << ": " << error << "\n";
+      return kExitBadInput;
+    }
+  }
+  const cia::SolveStatus status = report.result.status;
+  if (status != cia::SolveStatus::kOk) {
+    std::cerr << "calibrate_bag: " << report.result.message << "\n";
+    return kExitNotEnough;  // the bag was read; it did not hold enough information
+  }
+  if (args.has("--output")) {
+    try {
+      cia::ResultMetadata meta{report.camera_frame, report.imu_frame,
+                               static_cast<int>(pipeline.poses().size())};
+      cia::writeResultYaml(args.get("--output"), report.result, meta);
+    } catch (const cia::InputError& e) {
+      std::cerr << "calibrate_bag: " << e.what() << "\n";
+      return kExitBadInput;
+    }
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  cia::CliArgs args = [&] {
+    try {
+      return cia::CliArgs(argc, argv,
+                          {"--bag", "--target", "--config", "--imu-topic", "--mag-topic",
+                           "--image-topic", "--camera-info-topic", "--method", "--imu-orientation",
+                           "--output", "--report", "--truth"},
+                          {"--help", "--quiet"});
+    } catch (const cia::UsageError& e) {
+      std::cerr << "calibrate_bag: " << e.what() << "\n" << kUsage;
+      std::exit(kExitBadInput);
+    }
+  }();
+  if (args.has("--help")) {
+    std::cout << kUsage;
+    return kExitOk;
+  }
+  if (!args.has("--bag") || !args.has("--target")) {
+    std::cerr << "calibrate_bag: --bag and --target are required\n" << kUsage;
+    return kExitBadInput;
+  }
+  return run(args);
+}

@@ -1,0 +1,189 @@
+// calibrate_bag end to end on bags written by simulate_bag (ground truth in their truth YAML) and
+// on the real imu_tools bags: accuracy, honest 1-sigma, exit codes, messages.
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Geometry>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+
+#include "camera_imu_alignment/result_yaml.h"
+#include "camera_imu_alignment/rotation_math.h"
+#include "tool_runner.h"
+
+namespace camera_imu_alignment {
+namespace {
+
+const std::string kCalibrate = CALIBRATE_BAG_EXE;
+const std::string kSimulate = SIMULATE_BAG_EXE;
+const std::string kRealData = REALDATA_DIR;
+
+std::string temp(const std::string& name) { return test::processTempDir() + name; }
+
+/// Simulates a bag (scenario + extra options) and returns its path.
+std::string simulate(const std::string& name, const std::string& options) {
+  const std::string bag = temp(name + ".bag");
+  // 5 Hz instead of the default 15: a third of the bag size and rendering, same information.
+  const test::ToolRun r =
+      test::runTool(kSimulate + " --out " + bag + " --camera-rate-hz 5 " + options);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  return bag;
+}
+
+std::string stem(const std::string& bag) { return bag.substr(0, bag.size() - 4); }
+
+void removeBag(const std::string& bag) {
+  std::filesystem::remove(bag);
+  std::filesystem::remove(stem(bag) + ".truth.yaml");
+  std::filesystem::remove(stem(bag) + ".target.yaml");
+}
+
+struct Calibration {
+  test::ToolRun run;
+  Eigen::Matrix3d R_cam_imu = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d std_dev_deg = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d R_cam_imu_true = Eigen::Matrix3d::Identity();
+};
+
+Calibration calibrate(const std::string& bag, const std::string& options = "") {
+  Calibration c;
+  const std::string output = temp("result.yaml");
+  std::filesystem::remove(output);
+  c.run = test::runTool(kCalibrate + " --quiet --bag " + bag + " --target " + stem(bag) +
+                        ".target.yaml --output " + output + " " + options);
+  c.R_cam_imu_true = readResultYaml(stem(bag) + ".truth.yaml").R_cam_imu;
+  if (c.run.exit_code == 0) {
+    c.R_cam_imu = readResultYaml(output).R_cam_imu;
+    const auto sigma = YAML::LoadFile(output)["quality"]["std_dev_deg"].as<std::vector<double>>();
+    c.std_dev_deg = Eigen::Vector3d(sigma[0], sigma[1], sigma[2]);
+  }
+  return c;
+}
+
+/// Within `max_error_deg` of the truth, and the truth within `sigmas` sigma on every camera axis.
+void expectAccurate(const Calibration& c, double max_error_deg, const std::string& what,
+                    double sigmas = 3.0) {
+  ASSERT_EQ(c.run.exit_code, 0) << what << "\n" << c.run.err << c.run.out;
+  const Eigen::Vector3d error = test::leftError(c.R_cam_imu, c.R_cam_imu_true);
+  EXPECT_LT(rad2deg(error.norm()), max_error_deg) << what << "\n" << c.run.out;
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_LT(std::abs(rad2deg(error(axis))), sigmas * c.std_dev_deg(axis) + 1e-3)
+        << what << " axis " << axis << ", 1-sigma " << c.std_dev_deg.transpose();
+  }
+}
+
+struct Case {
+  const char* name;
+  const char* options;
+  double max_error_deg;
+};
+
+TEST(CalibrateBag, SimulatedScenariosAreWithinATenthOfADegree) {
+  const Case cases[] = {
+      {"nominal", "--scenario nominal --seed 21", 0.1},
+      {"aprilgrid", "--scenario aprilgrid --seed 22", 0.1},
+      {"noisy_imu", "--scenario noisy_imu --seed 23", 0.25},  // 5x noise: the 1-sigma decides
+      {"magnetic_disturbance", "--scenario magnetic_disturbance --seed 24", 0.1},
+      {"time_offset_30ms", "--scenario nominal --seed 25 --camera-time-offset-s 0.03", 0.1},
+      {"no_magnetometer", "--scenario no_magnetometer --seed 26", 0.1},
+  };
+  for (const Case& c : cases) {
+    const std::string bag = simulate(c.name, c.options);
+    const Calibration result = calibrate(bag);
+    expectAccurate(result, c.max_error_deg, c.name);
+    // The summary names the estimate and the blocks for other tools.
+    EXPECT_NE(result.run.out.find("T_cam_imu"), std::string::npos) << c.name;
+    EXPECT_NE(result.run.out.find("static_transform_publisher"), std::string::npos) << c.name;
+    removeBag(bag);
+  }
+}
+
+TEST(CalibrateBag, FewPosesGiveAnAnswerWhoseSigmaCoversTheError) {
+  const std::string bag = simulate("few_poses", "--scenario few_poses --seed 27");
+  const Calibration result = calibrate(bag);
+  // 3 poses: the noise scale rests on 6 residual dimensions, so the error is Student-t with 6
+  // degrees of freedom; its two-sided 99.7 % point is 5.0 scale units = 4.1 of the reported sigma
+  // (which already includes the t variance, sqrt(6 / 4) x the scale).
+  expectAccurate(result, 0.5, "few_poses", 4.1);
+  removeBag(bag);
+}
+
+TEST(CalibrateBag, SingleAxisMotionExitsThreeNamingTheAxisToRotateAbout) {
+  const std::string bag = simulate("degenerate", "--scenario degenerate --seed 28");
+  const Calibration result = calibrate(bag, "--report " + temp("degenerate.png"));
+  EXPECT_EQ(result.run.exit_code, 3) << result.run.err;
+  EXPECT_NE(result.run.err.find("camera x or y"), std::string::npos) << result.run.err;
+  EXPECT_FALSE(std::filesystem::exists(temp("result.yaml")));  // no result to trust
+  EXPECT_FALSE(cv::imread(temp("degenerate.png")).empty());    // but the report shows why
+  removeBag(bag);
+}
+
+TEST(CalibrateBag, TruncatedBagExitsTwoWithoutCrashing) {
+  const std::string bag = simulate("truncated", "--scenario nominal --seed 29 --num-poses 4");
+  const auto size = std::filesystem::file_size(bag);
+  for (double fraction : {0.6, 0.02}) {
+    const std::string cut = temp("cut.bag");
+    std::filesystem::copy_file(bag, cut, std::filesystem::copy_options::overwrite_existing);
+    std::filesystem::resize_file(cut, static_cast<std::uintmax_t>(fraction * size));
+    const test::ToolRun r = test::runTool(kCalibrate + " --bag " + cut + " --target " + stem(bag) +
+                                          ".target.yaml");
+    EXPECT_EQ(r.exit_code, 2) << fraction << "\n" << r.err;
+    EXPECT_NE(r.err.find("cut.bag"), std::string::npos) << r.err;
+  }
+  removeBag(bag);
+}
+
+TEST(CalibrateBag, BadUsageAndInputsExitTwoNamingTheCulprit) {
+  const std::string bag = simulate("usage", "--scenario nominal --seed 30 --num-poses 3");
+  const std::string target = stem(bag) + ".target.yaml";
+  struct Bad {
+    std::string args, expected;
+  };
+  const Bad bad[] = {
+      {"--target " + target, "--bag"},
+      {"--bag " + bag, "--target"},
+      {"--bag " + temp("missing.bag") + " --target " + target, "missing.bag"},
+      {"--bag " + bag + " --target " + temp("missing.yaml"), "missing.yaml"},
+      {"--bag " + bag + " --target " + target + " --imu-topic /nope", "/nope"},
+      {"--bag " + bag + " --target " + target + " --imu-topic camera/image_raw",
+       "sensor_msgs/Image"},
+      {"--bag " + bag + " --target " + target + " --method best", "--method"},
+      {"--bag " + bag + " --target " + target + " --config " + target, "unknown key"},
+  };
+  for (const Bad& b : bad) {
+    const test::ToolRun r = test::runTool(kCalibrate + " " + b.args);
+    EXPECT_EQ(r.exit_code, 2) << b.args << "\n" << r.err;
+    EXPECT_NE(r.err.find(b.expected), std::string::npos) << b.args << "\n" << r.err;
+  }
+  EXPECT_EQ(test::runTool(kCalibrate + " --help").exit_code, 0);
+  removeBag(bag);
+}
+
+TEST(CalibrateBag, RealImuOnlyBagsAreReadCompletelyThenNoCameraData) {
+  const std::string dir = kRealData + "/imu_tools_bags";
+  if (!std::filesystem::exists(dir)) GTEST_SKIP() << dir << " not found";
+  // A target file is needed to get that far.
+  const std::string target = temp("checkerboard.yaml");
+  std::ofstream(target) << "target_type: checkerboard\ntargetCols: 8\ntargetRows: 6\n"
+                           "rowSpacingMeters: 0.04\ncolSpacingMeters: 0.04\n";
+  struct Bag {
+    const char* file;
+    int imu_messages;  // rosbag info
+  };
+  for (const Bag& b : {Bag{"phidgets_imu_upside_down.bag", 13964}, Bag{"ardrone_imu.bag", 4308},
+                       Bag{"sparkfun_razor.bag", 2144}}) {
+    const test::ToolRun r =
+        test::runTool(kCalibrate + " --quiet --bag " + dir + "/" + b.file + " --target " + target);
+    EXPECT_EQ(r.exit_code, 2) << b.file << "\n" << r.err;
+    EXPECT_NE(r.err.find("no camera data"), std::string::npos) << b.file << "\n" << r.err;
+    const auto read = r.err.find("] read ");
+    ASSERT_NE(read, std::string::npos) << r.err;
+    // Every message reached the pipeline; at most 1 % refused (duplicate stamps and the like).
+    const long accepted = std::stol(r.err.substr(read + 7));
+    EXPECT_LE(accepted, b.imu_messages) << b.file;
+    EXPECT_GE(accepted, 0.99 * b.imu_messages) << b.file << "\n" << r.err;
+  }
+}
+
+}  // namespace
+}  // namespace camera_imu_alignment

@@ -1,0 +1,163 @@
+// ROS messages -> core structs (src/ros/message_conversion.cpp): every supported image encoding
+// gives the same grey image, inconsistent messages are refused with a reason, CameraInfo fields
+// map to the intrinsics.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "camera_imu_alignment/ros/message_conversion.h"
+
+namespace camera_imu_alignment {
+namespace {
+
+/// A 37x23 grey ramp (odd sizes catch step/width mix-ups).
+cv::Mat greyRamp() {
+  cv::Mat grey(23, 37, CV_8UC1);
+  for (int r = 0; r < grey.rows; ++r) {
+    for (int c = 0; c < grey.cols; ++c) grey.at<std::uint8_t>(r, c) = (7 * r + 5 * c) % 256;
+  }
+  return grey;
+}
+
+sensor_msgs::Image imageMessage(const cv::Mat& m, const std::string& encoding, int padding = 0) {
+  sensor_msgs::Image msg;
+  msg.encoding = encoding;
+  msg.width = m.cols;
+  msg.height = m.rows;
+  const std::size_t row = m.cols * m.elemSize();
+  msg.step = static_cast<std::uint32_t>(row + padding);
+  msg.data.assign(msg.step * m.rows, 0);
+  for (int r = 0; r < m.rows; ++r) std::memcpy(&msg.data[r * msg.step], m.ptr(r), row);
+  return msg;
+}
+
+double maxDifference(const cv::Mat& a, const cv::Mat& b) {
+  cv::Mat diff;
+  cv::absdiff(a, b, diff);
+  double max = 0.0;
+  cv::minMaxLoc(diff, nullptr, &max);
+  return max;
+}
+
+TEST(MessageConversion, EverySupportedEncodingGivesTheGreyImage) {
+  const cv::Mat grey = greyRamp();
+  cv::Mat bgr, rgb, bgra, rgba, grey16;
+  cv::cvtColor(grey, bgr, cv::COLOR_GRAY2BGR);
+  cv::cvtColor(grey, rgb, cv::COLOR_GRAY2RGB);
+  cv::cvtColor(grey, bgra, cv::COLOR_GRAY2BGRA);
+  cv::cvtColor(grey, rgba, cv::COLOR_GRAY2RGBA);
+  grey.convertTo(grey16, CV_16U, 256.0);
+  cv::Mat grey12;  // a 12-bit camera's mono16: values up to 4095
+  grey.convertTo(grey12, CV_16U, 16.0);
+  const std::pair<cv::Mat, std::string> cases[] = {
+      {grey, "mono8"}, {grey, "8UC1"}, {bgr, "bgr8"},     {rgb, "rgb8"},
+      {bgra, "bgra8"}, {rgba, "rgba8"}, {grey16, "mono16"}, {grey16, "16UC1"},
+      {grey12, "mono16"}};
+  for (const auto& [image, encoding] : cases) {
+    for (int padding : {0, 3}) {
+      cv::Mat mono;
+      std::string error;
+      ASSERT_TRUE(toMono8(imageMessage(image, encoding, padding), &mono, &error))
+          << encoding << ": " << error;
+      ASSERT_EQ(mono.type(), CV_8UC1);
+      ASSERT_EQ(mono.size(), grey.size());
+      EXPECT_LE(maxDifference(mono, grey), 1.0) << encoding;
+    }
+  }
+}
+
+TEST(MessageConversion, InconsistentImagesAreRefusedWithAReason) {
+  const cv::Mat grey = greyRamp();
+  std::string error;
+  cv::Mat mono;
+  sensor_msgs::Image msg = imageMessage(grey, "bayer_rggb8");
+  EXPECT_FALSE(toMono8(msg, &mono, &error));
+  EXPECT_NE(error.find("bayer_rggb8"), std::string::npos) << error;
+  msg = imageMessage(grey, "mono8");
+  msg.data.resize(msg.data.size() - 1);  // truncated payload
+  EXPECT_FALSE(toMono8(msg, &mono, &error));
+  msg = imageMessage(grey, "rgb8");  // says rgb8, carries one byte per pixel
+  EXPECT_FALSE(toMono8(msg, &mono, &error));
+  msg = sensor_msgs::Image();  // empty
+  msg.encoding = "mono8";
+  EXPECT_FALSE(toMono8(msg, &mono, &error));
+  msg = imageMessage(grey, "mono8");
+  msg.step = 10;  // shorter than a row
+  EXPECT_FALSE(toMono8(msg, &mono, &error));
+}
+
+TEST(MessageConversion, CompressedImagesDecodeAndGarbageIsRefused) {
+  const cv::Mat grey = greyRamp();
+  for (const char* ext : {".png", ".jpg"}) {
+    sensor_msgs::CompressedImage msg;
+    msg.format = ext + 1;
+    ASSERT_TRUE(cv::imencode(ext, grey, msg.data));
+    cv::Mat mono;
+    std::string error;
+    ASSERT_TRUE(toMono8(msg, &mono, &error)) << error;
+    EXPECT_EQ(mono.size(), grey.size());
+    EXPECT_LE(maxDifference(mono, grey), std::string(ext) == ".png" ? 0.0 : 12.0) << ext;
+  }
+  sensor_msgs::CompressedImage garbage;
+  garbage.format = "jpeg";
+  garbage.data = {1, 2, 3, 4, 5};
+  cv::Mat mono;
+  std::string error;
+  EXPECT_FALSE(toMono8(garbage, &mono, &error));
+  EXPECT_FALSE(error.empty());
+  garbage.data.clear();
+  EXPECT_FALSE(toMono8(garbage, &mono, &error));
+}
+
+TEST(MessageConversion, CameraInfoMapsToIntrinsicsAndBadOnesAreRefused) {
+  sensor_msgs::CameraInfo info;
+  info.width = 640;
+  info.height = 480;
+  info.K = {500.0, 0.0, 319.5, 0.0, 501.0, 239.5, 0.0, 0.0, 1.0};
+  info.distortion_model = "plumb_bob";
+  info.D = {0.1, -0.05, 0.001, 0.002, 0.0};
+  CameraIntrinsics intrinsics;
+  std::string error;
+  ASSERT_TRUE(toCameraIntrinsics(info, &intrinsics, &error)) << error;
+  EXPECT_EQ(intrinsics.width, 640);
+  EXPECT_EQ(intrinsics.K(1, 1), 501.0);
+  EXPECT_EQ(intrinsics.K(0, 2), 319.5);
+  EXPECT_EQ(intrinsics.distortion, CameraIntrinsics::Distortion::kPlumbBob);
+  EXPECT_EQ(intrinsics.D.size(), 5u);
+
+  sensor_msgs::CameraInfo zero_k = info;
+  zero_k.K.fill(0.0);
+  EXPECT_FALSE(toCameraIntrinsics(zero_k, &intrinsics, &error));
+  EXPECT_FALSE(error.empty());
+  sensor_msgs::CameraInfo short_d = info;
+  short_d.D = {0.1, 0.2, 0.3};
+  EXPECT_FALSE(toCameraIntrinsics(short_d, &intrinsics, &error));
+  EXPECT_NE(error.find("3"), std::string::npos) << error;
+  sensor_msgs::CameraInfo unknown = info;
+  unknown.distortion_model = "mystery";
+  EXPECT_FALSE(toCameraIntrinsics(unknown, &intrinsics, &error));
+  EXPECT_NE(error.find("mystery"), std::string::npos) << error;
+}
+
+TEST(MessageConversion, ImuAndMagneticFieldKeepStampsAndAxes) {
+  sensor_msgs::Imu imu;
+  imu.header.stamp = ros::Time(1700000000, 250000000);
+  imu.angular_velocity.x = 0.1;
+  imu.angular_velocity.y = -0.2;
+  imu.angular_velocity.z = 0.3;
+  imu.linear_acceleration.z = 9.81;
+  const ImuSample sample = toImuSample(imu);
+  EXPECT_DOUBLE_EQ(sample.stamp_s, 1700000000.25);
+  EXPECT_EQ(sample.gyro_rad_s, Eigen::Vector3d(0.1, -0.2, 0.3));
+  EXPECT_EQ(sample.accel_m_s2, Eigen::Vector3d(0.0, 0.0, 9.81));
+  sensor_msgs::MagneticField mag;
+  mag.header.stamp = ros::Time(5, 0);
+  mag.magnetic_field.y = 22e-6;
+  const MagneticSample field = toMagneticSample(mag);
+  EXPECT_EQ(field.stamp_s, 5.0);
+  EXPECT_EQ(field.field_t, Eigen::Vector3d(0.0, 22e-6, 0.0));
+}
+
+}  // namespace
+}  // namespace camera_imu_alignment
