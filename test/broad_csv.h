@@ -28,9 +28,9 @@ namespace test {
 
 struct BroadRecording {
   std::vector<ImuSample> imu;
-  std::vector<MagneticSample> mag;    ///< tesla, same stamps as imu
+  std::vector<MagneticSample> mag;        ///< tesla, same stamps as imu
   std::vector<Eigen::Quaterniond> ref_q;  ///< q_ref_imu; coefficients NaN when unavailable
-  std::vector<int> moving;            ///< 0 at rest, 1 moving (authors' label)
+  std::vector<int> moving;                ///< 0 at rest, 1 moving (authors' label)
   std::size_t size() const { return imu.size(); }
   bool refValid(std::size_t i) const { return std::isfinite(ref_q[i].w()); }
 };
@@ -55,9 +55,9 @@ inline std::optional<BroadRecording> loadBroad(const std::string& file_name) {
       col[name] = k++;
     }
   }
-  const char* names[] = {"t_s",      "gyr_x",    "gyr_y",    "gyr_z",  "acc_x",  "acc_y",
-                         "acc_z",    "mag_x_uT", "mag_y_uT", "mag_z_uT", "ref_qw", "ref_qx",
-                         "ref_qy",   "ref_qz",   "moving"};
+  const char* names[] = {"t_s",    "gyr_x",  "gyr_y",    "gyr_z",    "acc_x",
+                         "acc_y",  "acc_z",  "mag_x_uT", "mag_y_uT", "mag_z_uT",
+                         "ref_qw", "ref_qx", "ref_qy",   "ref_qz",   "moving"};
   std::vector<int> idx;
   for (const char* n : names) {
     auto it = col.find(n);
@@ -80,7 +80,9 @@ inline std::optional<BroadRecording> loadBroad(const std::string& file_name) {
       ++p;
     }
     if (values.size() < col.size()) return std::nullopt;
-    auto v = [&](int k) { return values[static_cast<std::size_t>(idx[static_cast<std::size_t>(k)])]; };
+    auto v = [&](int k) {
+      return values[static_cast<std::size_t>(idx[static_cast<std::size_t>(k)])];
+    };
     ImuSample s;
     s.stamp_s = v(0);
     s.gyro_rad_s = Eigen::Vector3d(v(1), v(2), v(3));

@@ -29,7 +29,7 @@ struct Injected {
 struct PipelineRun {
   std::unique_ptr<simulation::SimulationRun> run;
   std::unique_ptr<CalibrationPipeline> pipeline;
-  std::vector<AlignmentResult> results;  ///< every on_result, in order
+  std::vector<AlignmentResult> results;     ///< every on_result, in order
   std::vector<std::string> reject_details;  ///< on_reject details, first 200
   Injected injected;
   Eigen::Matrix3d R_cam_imu_true() const { return run->trajectory.R_cam_imu_final(); }
@@ -45,13 +45,14 @@ inline CameraIntrinsics simulatedIntrinsics(const simulation::SimulationConfig& 
   return intrinsics;
 }
 
-inline bool every(std::size_t i, int n) { return n > 0 && i % n == static_cast<std::size_t>(n - 1); }
+inline bool every(std::size_t i, int n) {
+  return n > 0 && i % n == static_cast<std::size_t>(n - 1);
+}
 
 /// Feeds a simulated run (possibly edited by the test) to a new pipeline: IMU, magnetometer and
 /// rendered frames merged in stamp order, with `injection` bad samples mixed in.
 inline PipelineRun feedPipeline(std::unique_ptr<simulation::SimulationRun> simulated,
-                                const PipelineSettings& settings,
-                                const Injection& injection = {}) {
+                                const PipelineSettings& settings, const Injection& injection = {}) {
   namespace sim = simulation;
   PipelineRun out;
   out.run = std::move(simulated);
@@ -63,7 +64,8 @@ inline PipelineRun feedPipeline(std::unique_ptr<simulation::SimulationRun> simul
   callbacks.on_result = [results](const AlignmentResult& r) { results->push_back(r); };
   std::vector<std::string>* details = &out.reject_details;
   callbacks.on_reject = [details](RejectReason reason, const std::string& detail) {
-    if (details->size() < 200) details->push_back(std::string(rejectReasonName(reason)) + ": " + detail);
+    if (details->size() < 200)
+      details->push_back(std::string(rejectReasonName(reason)) + ": " + detail);
   };
   out.pipeline = std::make_unique<CalibrationPipeline>(target, settings, callbacks);
   CalibrationPipeline& pipeline = *out.pipeline;
@@ -128,8 +130,9 @@ inline PipelineRun feedPipeline(std::unique_ptr<simulation::SimulationRun> simul
     } else {
       grey = renderer.renderAt(run.trajectory, t);
     }
-    pipeline.addFrame({stamp, sim::ImageRenderer::toMono8(grey, c.noise_scale * c.pixel_noise_sigma,
-                                                          run.frameNoiseSeed(static_cast<long>(j)))});
+    pipeline.addFrame(
+        {stamp, sim::ImageRenderer::toMono8(grey, c.noise_scale * c.pixel_noise_sigma,
+                                            run.frameNoiseSeed(static_cast<long>(j)))});
   }
   feedInertialUpTo(std::numeric_limits<double>::infinity());
   pipeline.finish();

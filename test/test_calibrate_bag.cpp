@@ -125,8 +125,8 @@ TEST(CalibrateBag, TruncatedBagExitsTwoWithoutCrashing) {
     const std::string cut = temp("cut.bag");
     std::filesystem::copy_file(bag, cut, std::filesystem::copy_options::overwrite_existing);
     std::filesystem::resize_file(cut, static_cast<std::uintmax_t>(fraction * size));
-    const test::ToolRun r = test::runTool(kCalibrate + " --bag " + cut + " --target " + stem(bag) +
-                                          ".target.yaml");
+    const test::ToolRun r =
+        test::runTool(kCalibrate + " --bag " + cut + " --target " + stem(bag) + ".target.yaml");
     EXPECT_EQ(r.exit_code, 2) << fraction << "\n" << r.err;
     EXPECT_NE(r.err.find("cut.bag"), std::string::npos) << r.err;
   }

@@ -112,8 +112,8 @@ TEST(CalibrationPipeline, WithoutMagnetometerTheGyroCarriesTheHeading) {
 }
 
 TEST(CalibrationPipeline, DisturbedFieldIsFlaggedAndNeverUsed) {
-  for (ImuOrientationSource source : {ImuOrientationSource::kAuto,
-                                      ImuOrientationSource::kMagnetometer}) {
+  for (ImuOrientationSource source :
+       {ImuOrientationSource::kAuto, ImuOrientationSource::kMagnetometer}) {
     PipelineSettings settings;
     settings.imu_orientation = source;
     const sim::SimulationConfig c = scenario("magnetic_disturbance", 11);
@@ -122,9 +122,9 @@ TEST(CalibrationPipeline, DisturbedFieldIsFlaggedAndNeverUsed) {
     int flagged = 0;
     for (const auto& pose : r.pipeline->poses()) {
       const int hold = trueHold(trajectory, pose.start_s, pose.end_s);
-      const bool disturbed = std::find(c.mag_disturbance_poses.begin(),
-                                       c.mag_disturbance_poses.end(),
-                                       hold) != c.mag_disturbance_poses.end();
+      const bool disturbed =
+          std::find(c.mag_disturbance_poses.begin(), c.mag_disturbance_poses.end(), hold) !=
+          c.mag_disturbance_poses.end();
       if (disturbed) {
         EXPECT_FALSE(pose.magnetometer_usable) << "hold " << hold;
         EXPECT_NE(pose.imu_source, "accel_mag");

@@ -17,8 +17,8 @@
 namespace camera_imu_alignment {
 namespace {
 
-const Eigen::Vector3d kUpSpecificForce(0.0, 0.0, 9.81);   // ENU, what an accelerometer at rest reads
-const Eigen::Vector3d kEarthField(0.0, 22e-6, -42e-6);    // T, ENU (north and down)
+const Eigen::Vector3d kUpSpecificForce(0.0, 0.0, 9.81);  // ENU, what an accelerometer at rest reads
+const Eigen::Vector3d kEarthField(0.0, 22e-6, -42e-6);   // T, ENU (north and down)
 
 Eigen::Matrix3d randomRotation(std::mt19937& rng) {
   std::normal_distribution<double> n(0.0, 1.0);
@@ -51,7 +51,8 @@ TEST(AttitudeFromAccelMag, DisturbedFieldChangesTheHeadingOnlyAndDegenerateInput
   std::mt19937 rng(2);
   const Eigen::Matrix3d R_world_imu = randomRotation(rng);
   const Eigen::Vector3d accel = R_world_imu.transpose() * kUpSpecificForce;
-  const Eigen::Vector3d bad_field = R_world_imu.transpose() * (kEarthField + Eigen::Vector3d(15e-6, 0, 8e-6));
+  const Eigen::Vector3d bad_field =
+      R_world_imu.transpose() * (kEarthField + Eigen::Vector3d(15e-6, 0, 8e-6));
   const AttitudeFromVectors a = attitudeFromAccelMag(accel, bad_field);
   ASSERT_TRUE(a.valid);
   // Gravity is still exact: the up axis agrees; the error is a rotation about it.
@@ -334,7 +335,8 @@ TEST_P(Broad, DetectorAgreesWithTheAuthorsLabelsAndAttitudeWithTheReference) {
     ref.push_back(R_ref);
     const Eigen::Vector3d up_ours = a.R_world_imu.transpose().col(2);
     const Eigen::Vector3d up_ref = R_ref.transpose().col(2);
-    EXPECT_LT(rad2deg(std::acos(std::min(1.0, up_ours.dot(up_ref)))), 1.0) << "tilt, rest at " << s.start_s;
+    EXPECT_LT(rad2deg(std::acos(std::min(1.0, up_ours.dot(up_ref)))), 1.0)
+        << "tilt, rest at " << s.start_s;
   }
   ASSERT_GE(ours.size(), 3u);
   double worst = 0.0;

@@ -51,9 +51,8 @@ TEST(MessageConversion, EverySupportedEncodingGivesTheGreyImage) {
   cv::Mat grey12;  // a 12-bit camera's mono16: values up to 4095
   grey.convertTo(grey12, CV_16U, 16.0);
   const std::pair<cv::Mat, std::string> cases[] = {
-      {grey, "mono8"}, {grey, "8UC1"}, {bgr, "bgr8"},     {rgb, "rgb8"},
-      {bgra, "bgra8"}, {rgba, "rgba8"}, {grey16, "mono16"}, {grey16, "16UC1"},
-      {grey12, "mono16"}};
+      {grey, "mono8"}, {grey, "8UC1"},     {bgr, "bgr8"},     {rgb, "rgb8"},     {bgra, "bgra8"},
+      {rgba, "rgba8"}, {grey16, "mono16"}, {grey16, "16UC1"}, {grey12, "mono16"}};
   for (const auto& [image, encoding] : cases) {
     for (int padding : {0, 3}) {
       cv::Mat mono;

@@ -135,8 +135,7 @@ TEST(PipelineConfig, BadFilesAreRefusedNamingTheKey) {
 
 TEST(PipelineConfig, RosOnlyKeysCanBeSkippedAndPartialFilesKeepTheRest) {
   PipelineSettings s;
-  parsePipelineConfig("camera_frame: cam\nwindow_poses: 12\n", "params.yaml", &s,
-                      {"camera_frame"});
+  parsePipelineConfig("camera_frame: cam\nwindow_poses: 12\n", "params.yaml", &s, {"camera_frame"});
   EXPECT_EQ(s.window_poses, 12u);
   EXPECT_EQ(s.stationary.window_s, PipelineSettings().stationary.window_s);
 }

@@ -2,6 +2,7 @@
 // the simulator's exact truth) and on ViSP's real Franka images (against ViSP's hand-eye result).
 #include <gtest/gtest.h>
 
+#include <yaml-cpp/yaml.h>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -10,7 +11,6 @@
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
-#include <yaml-cpp/yaml.h>
 
 #include "camera_imu_alignment/alignment_solver.h"
 #include "camera_imu_alignment/camera_model.h"
@@ -64,8 +64,8 @@ std::vector<int> symmetryAngles(const std::string& yaml) {
   std::vector<int> out;
   for (const auto& S : TargetDetector(parseTargetYaml(yaml, "t")).symmetries()) {
     EXPECT_NEAR(S(2, 2), 1.0, 1e-12);  // about the target z axis
-    out.push_back(static_cast<int>(std::lround(
-        std::fmod(std::atan2(S(1, 0), S(0, 0)) * 180.0 / M_PI + 360.0, 360.0))));
+    out.push_back(static_cast<int>(
+        std::lround(std::fmod(std::atan2(S(1, 0), S(0, 0)) * 180.0 / M_PI + 360.0, 360.0))));
   }
   std::sort(out.begin(), out.end());
   return out;
@@ -74,8 +74,9 @@ std::vector<int> symmetryAngles(const std::string& yaml) {
 TEST(TargetSymmetry, CountsTheTurnsThatLeaveTheBoardAndItsColoursUnchanged) {
   auto checkerboard = [](int cols, int rows, double col_m, double row_m) {
     return "target_type: checkerboard\ntargetCols: " + std::to_string(cols) +
-           "\ntargetRows: " + std::to_string(rows) + "\ncolSpacingMeters: " +
-           std::to_string(col_m) + "\nrowSpacingMeters: " + std::to_string(row_m) + "\n";
+           "\ntargetRows: " + std::to_string(rows) +
+           "\ncolSpacingMeters: " + std::to_string(col_m) +
+           "\nrowSpacingMeters: " + std::to_string(row_m) + "\n";
   };
   // 8x6 inner corners = 9x7 squares: a half turn maps black squares onto black squares.
   EXPECT_EQ(symmetryAngles(checkerboard(8, 6, 0.04, 0.04)), (std::vector<int>{180}));
@@ -129,20 +130,20 @@ TEST(CameraModel, FromCameraInfoValidatesEveryField) {
   const double zero[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
   CameraIntrinsics c;
   std::string error;
-  EXPECT_TRUE(CameraIntrinsics::fromCameraInfo(640, 480, K, "plumb_bob", {0.1, -0.2, 0, 0, 0}, &c,
-                                               &error))
+  EXPECT_TRUE(
+      CameraIntrinsics::fromCameraInfo(640, 480, K, "plumb_bob", {0.1, -0.2, 0, 0, 0}, &c, &error))
       << error;
   EXPECT_EQ(c.distortion, CameraIntrinsics::Distortion::kPlumbBob);
-  EXPECT_TRUE(CameraIntrinsics::fromCameraInfo(640, 480, K, "plumb_bob", {0, 0, 0, 0, 0}, &c,
-                                               &error));
+  EXPECT_TRUE(
+      CameraIntrinsics::fromCameraInfo(640, 480, K, "plumb_bob", {0, 0, 0, 0, 0}, &c, &error));
   EXPECT_EQ(c.distortion, CameraIntrinsics::Distortion::kNone);  // zero D: pinhole
   EXPECT_FALSE(CameraIntrinsics::fromCameraInfo(640, 480, zero, "plumb_bob", {}, &c, &error));
   EXPECT_NE(error.find("K is zero"), std::string::npos);
   EXPECT_FALSE(
       CameraIntrinsics::fromCameraInfo(640, 480, K, "plumb_bob", {0.1, 0.2, 0.3}, &c, &error));
   EXPECT_NE(error.find("3 coefficients"), std::string::npos);
-  EXPECT_FALSE(CameraIntrinsics::fromCameraInfo(640, 480, K, "equidistant", {0.1, 0.2, 0.3, 0.4, 0.5},
-                                                &c, &error));
+  EXPECT_FALSE(CameraIntrinsics::fromCameraInfo(640, 480, K, "equidistant",
+                                                {0.1, 0.2, 0.3, 0.4, 0.5}, &c, &error));
   EXPECT_FALSE(CameraIntrinsics::fromCameraInfo(640, 480, K, "mei", {0.1}, &c, &error));
   EXPECT_NE(error.find("mei"), std::string::npos);
   EXPECT_FALSE(CameraIntrinsics::fromCameraInfo(0, 480, K, "", {}, &c, &error));
@@ -195,8 +196,8 @@ CameraIntrinsics intrinsicsOf(const SimulationConfig& c) {
   CameraIntrinsics intrinsics;
   std::string error;
   const std::vector<double> D(c.distortion.begin(), c.distortion.end());
-  EXPECT_TRUE(CameraIntrinsics::fromCameraInfo(c.width, c.height, K, "plumb_bob", D, &intrinsics,
-                                               &error))
+  EXPECT_TRUE(
+      CameraIntrinsics::fromCameraInfo(c.width, c.height, K, "plumb_bob", D, &intrinsics, &error))
       << error;
   return intrinsics;
 }
@@ -206,8 +207,9 @@ TargetDescription descriptionOf(const SimulationConfig& c) {
 }
 
 /// The held poses of a simulated run rendered as the simulator renders its frames.
-std::vector<RenderedView> renderHolds(const SimulationConfig& c, int max_views,
-                                      const Eigen::Matrix3d& extra_roll = Eigen::Matrix3d::Identity()) {
+std::vector<RenderedView> renderHolds(
+    const SimulationConfig& c, int max_views,
+    const Eigen::Matrix3d& extra_roll = Eigen::Matrix3d::Identity()) {
   const simulation::SimulationRun run(c);
   const simulation::ImageRenderer renderer(
       simulation::CameraModel::fromConfig(c),
@@ -217,12 +219,13 @@ std::vector<RenderedView> renderHolds(const SimulationConfig& c, int max_views,
   const auto& tr = run.trajectory;
   for (int k = 0; k < std::min<int>(max_views, tr.poses().size()); ++k) {
     const auto& p = tr.poses()[k];
-    const Eigen::Matrix3d R_target_cam = tr.R_world_target().transpose() * p.R_world_cam * extra_roll;
+    const Eigen::Matrix3d R_target_cam =
+        tr.R_world_target().transpose() * p.R_world_cam * extra_roll;
     const Eigen::Vector3d p_target_cam =
         tr.R_world_target().transpose() * (p.p_world_cam - tr.p_world_target());
     const cv::Mat grey = renderer.render(R_target_cam, p_target_cam);
-    views.push_back({simulation::ImageRenderer::toMono8(grey, c.pixel_noise_sigma, 99 + k),
-                     R_target_cam});
+    views.push_back(
+        {simulation::ImageRenderer::toMono8(grey, c.pixel_noise_sigma, 99 + k), R_target_cam});
   }
   return views;
 }
@@ -333,8 +336,8 @@ TEST(RenderedTargets, SymmetricBoardFollowsTheHintThroughAHalfTurn) {
   const CameraIntrinsics intrinsics = intrinsicsOf(c);
   const Eigen::Matrix3d roll180 =
       Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  const Eigen::Matrix3d tilt = Eigen::AngleAxisd(0.5, Eigen::Vector3d(1, 1, 0).normalized())
-                                   .toRotationMatrix();
+  const Eigen::Matrix3d tilt =
+      Eigen::AngleAxisd(0.5, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix();
   for (const RenderedView& v : renderHolds(c, 4, roll180)) {
     const Eigen::Matrix3d hint = v.R_target_cam * tilt;  // 29 degrees off
     TargetObservation obs;
@@ -459,16 +462,16 @@ TEST(VispRealImages, AllChessboardsFoundAndRotationMatchesVisp) {
     PoseOrientation p;
     p.stamp_s = i;
     p.R_target_cam = pose->R_target_cam;
-    ASSERT_TRUE(readVispRotation(dir + "/franka_pose_rPe_" + std::to_string(i) + ".yaml",
-                                 &p.R_world_imu))
+    ASSERT_TRUE(
+        readVispRotation(dir + "/franka_pose_rPe_" + std::to_string(i) + ".yaml", &p.R_world_imu))
         << i;
     poses.push_back(p);
   }
   const AlignmentResult result = solveAlignment(makeAllPairs(poses));
   ASSERT_EQ(result.status, SolveStatus::kOk) << result.message;
   Eigen::Matrix3d R_imu_cam_visp;
-  R_imu_cam_visp << -0.0110121, -0.999915, 0.0069391, 0.999929, -0.0109794, 0.00473584,
-      -0.00465925, 0.00699075, 0.999965;
+  R_imu_cam_visp << -0.0110121, -0.999915, 0.0069391, 0.999929, -0.0109794, 0.00473584, -0.00465925,
+      0.00699075, 0.999965;
   const double error_deg = angleDeg(result.R_cam_imu, R_imu_cam_visp.transpose());
   std::cout << "ViSP Franka: R_cam_imu differs from ViSP's estimate by " << error_deg << " deg\n";
   EXPECT_LT(error_deg, 0.1);

@@ -29,8 +29,8 @@ inline std::string readTextFile(const std::string& path) {
 inline ToolRun runTool(const std::string& command, int timeout_s = 120) {
   const std::string out_path = processTempDir() + "tool_stdout.txt";
   const std::string err_path = processTempDir() + "tool_stderr.txt";
-  const std::string cmd = "timeout " + std::to_string(timeout_s) + " " + command + " >" +
-                          out_path + " 2>" + err_path;
+  const std::string cmd =
+      "timeout " + std::to_string(timeout_s) + " " + command + " >" + out_path + " 2>" + err_path;
   const int status = std::system(cmd.c_str());
   ToolRun r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

@@ -70,16 +70,16 @@ struct PipelineSettings {
   PoseSettings pose;
   SolverOptions solver;
   ImuOrientationSource imu_orientation = ImuOrientationSource::kAuto;
-  std::size_t window_poses = 30;      ///< sliding window of stationary poses
-  int min_poses_to_solve = 3;         ///< solve only with at least this many poses in the window
-  int min_frames_per_pose = 2;        ///< camera frames with a pose needed for a stationary pose
-  int max_frames_per_pose = 10;       ///< detection stops after this many good frames per rest
-  double min_frame_interval_s = 0.15; ///< frames closer than this to the last detected one skipped
-  double frame_margin_s = 0.15;       ///< see "Time offsets" above
-  double max_camera_spread_deg = 0.5; ///< camera orientation scatter within a pose
-  double max_gyro_span_s = 120.0;     ///< longer motion between poses breaks the gyro chain
-  double frame_queue_s = 3.0;         ///< frames older than the IMU by more are dropped (no IMU)
-  double accel_weight = 0.9;          ///< attitudeFromAccelMag
+  std::size_t window_poses = 30;       ///< sliding window of stationary poses
+  int min_poses_to_solve = 3;          ///< solve only with at least this many poses in the window
+  int min_frames_per_pose = 2;         ///< camera frames with a pose needed for a stationary pose
+  int max_frames_per_pose = 10;        ///< detection stops after this many good frames per rest
+  double min_frame_interval_s = 0.15;  ///< frames closer than this to the last detected one skipped
+  double frame_margin_s = 0.15;        ///< see "Time offsets" above
+  double max_camera_spread_deg = 0.5;  ///< camera orientation scatter within a pose
+  double max_gyro_span_s = 120.0;      ///< longer motion between poses breaks the gyro chain
+  double frame_queue_s = 3.0;          ///< frames older than the IMU by more are dropped (no IMU)
+  double accel_weight = 0.9;           ///< attitudeFromAccelMag
   /// Returns an empty string when usable, else the first unusable setting, named by its key in
   /// config/alignment.yaml.
   std::string validate() const;
@@ -87,22 +87,23 @@ struct PipelineSettings {
 
 /// A stationary pose as the pipeline assembled it.
 struct StationaryPose {
-  int index = 0;        ///< 0-based, in order of the recording
-  int group = 0;        ///< poses of different groups never form a pair (see the rule above)
+  int index = 0;  ///< 0-based, in order of the recording
+  int group = 0;  ///< poses of different groups never form a pair (see the rule above)
   double start_s = 0.0, end_s = 0.0;  ///< the IMU segment (s)
   // Camera.
   Eigen::Matrix3d R_target_cam = Eigen::Matrix3d::Identity();
   Eigen::Vector3d p_target_cam = Eigen::Vector3d::Zero();  ///< m, from the last frame used
   int num_frames = 0;
-  double camera_spread_deg = 0.0;     ///< RMS of frame orientations about the average
-  double reprojection_rms_px = 0.0;   ///< mean over the frames used
+  double camera_spread_deg = 0.0;    ///< RMS of frame orientations about the average
+  double reprojection_rms_px = 0.0;  ///< mean over the frames used
   // IMU.
   Eigen::Matrix3d R_world_imu = Eigen::Matrix3d::Identity();  ///< used for the pairs
-  std::string imu_source;           ///< "gyro", "accel_mag", "accel_only"
+  std::string imu_source;                                     ///< "gyro", "accel_mag", "accel_only"
   bool magnetometer_usable = false;
-  std::string magnetometer_note;    ///< why not usable ("disturbed: dip changed by 5.1 deg", ...)
-  std::optional<Eigen::Matrix3d> R_world_imu_accel_mag;    ///< when the field is usable
-  std::optional<Eigen::Matrix3d> R_imu_previous_imu_gyro;  ///< gyro rotation since the previous pose
+  std::string magnetometer_note;  ///< why not usable ("disturbed: dip changed by 5.1 deg", ...)
+  std::optional<Eigen::Matrix3d> R_world_imu_accel_mag;  ///< when the field is usable
+  std::optional<Eigen::Matrix3d>
+      R_imu_previous_imu_gyro;                    ///< gyro rotation since the previous pose
   std::optional<double> gyro_mag_difference_deg;  ///< gyro vs accel+mag relative rotation
   Eigen::Vector3d gyro_bias_rad_s = Eigen::Vector3d::Zero();
 };
@@ -140,10 +141,10 @@ class CalibrationPipeline {
   /// Forgets everything (window, buffers, counts kept unless clear_counts).
   void reset(bool clear_counts = false);
 
-  const std::vector<StationaryPose>& poses() const;          ///< all poses so far
+  const std::vector<StationaryPose>& poses() const;  ///< all poses so far
   RotationPairs windowPairs() const;  ///< the pairs solve() uses (poses in the window)
   const std::vector<RejectedPose>& rejectedPoses() const;
-  const std::vector<StationarySegment>& segments() const;    ///< all IMU rests so far
+  const std::vector<StationarySegment>& segments() const;  ///< all IMU rests so far
   const RejectionCounts& rejections() const;
   std::optional<AlignmentResult> lastResult() const;
   /// Counters for progress and diagnostics.

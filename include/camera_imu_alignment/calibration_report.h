@@ -13,17 +13,17 @@
 namespace camera_imu_alignment {
 
 struct ReportInput {
-  AlignmentResult result;                  ///< the final solve (status, R_cam_imu, quality)
-  RotationPairs pairs;                     ///< the pairs it was solved on (same order as
-                                           ///< result.quality.pairs)
-  std::vector<StationaryPose> poses;       ///< poses accepted
-  std::vector<RejectedPose> rejected;      ///< rests that did not become poses, with reasons
-  std::vector<StationarySegment> segments; ///< every IMU rest
-  RejectionCounts rejections;              ///< inputs rejected by reason
-  double start_s = 0.0, end_s = 0.0;       ///< recording span (s), for the time axis
+  AlignmentResult result;                   ///< the final solve (status, R_cam_imu, quality)
+  RotationPairs pairs;                      ///< the pairs it was solved on (same order as
+                                            ///< result.quality.pairs)
+  std::vector<StationaryPose> poses;        ///< poses accepted
+  std::vector<RejectedPose> rejected;       ///< rests that did not become poses, with reasons
+  std::vector<StationarySegment> segments;  ///< every IMU rest
+  RejectionCounts rejections;               ///< inputs rejected by reason
+  double start_s = 0.0, end_s = 0.0;        ///< recording span (s), for the time axis
   std::string camera_frame = "camera_optical_frame";
   std::string imu_frame = "imu_link";
-  std::string source;                      ///< e.g. the bag path, shown in the title
+  std::string source;  ///< e.g. the bag path, shown in the title
 };
 
 /// The stdout summary: R_cam_imu as quaternion (xyzw), matrix and roll/pitch/yaw (deg, the

@@ -10,8 +10,8 @@ namespace camera_imu_alignment {
 
 struct CameraIntrinsics {
   enum class Distortion { kNone, kPlumbBob, kEquidistant };
-  int width = 0, height = 0;                          ///< pixels
-  Eigen::Matrix3d K = Eigen::Matrix3d::Zero();        ///< fx 0 cx; 0 fy cy; 0 0 1 (pixels)
+  int width = 0, height = 0;                    ///< pixels
+  Eigen::Matrix3d K = Eigen::Matrix3d::Zero();  ///< fx 0 cx; 0 fy cy; 0 0 1 (pixels)
   Distortion distortion = Distortion::kNone;
   std::vector<double> D;  ///< plumb_bob: k1 k2 p1 p2 k3 (5, or 4/8); equidistant: k1..k4
 
@@ -20,7 +20,8 @@ struct CameraIntrinsics {
   static bool fromCameraInfo(int width, int height, const double K_row_major[9],
                              const std::string& model, const std::vector<double>& D,
                              CameraIntrinsics* intrinsics, std::string* error);
-  /// Empty when usable, else what is wrong ("K is zero", "D has 3 coefficients, plumb_bob needs 5").
+  /// Empty when usable, else what is wrong ("K is zero", "D has 3 coefficients, plumb_bob needs
+  /// 5").
   std::string validate() const;
   cv::Mat cameraMatrix() const;  ///< CV_64F 3x3
   cv::Mat distCoeffs() const;    ///< CV_64F 1xN (empty for kNone)

@@ -16,9 +16,9 @@ namespace camera_imu_alignment {
 /// Orientation from gravity and the magnetic field.
 struct AttitudeFromVectors {
   Eigen::Matrix3d R_world_imu = Eigen::Matrix3d::Identity();  ///< ENU
-  double dip_deg = 0.0;         ///< magnetic inclination (below horizontal: positive in the north)
-  double field_norm_t = 0.0;    ///< |field| (T)
-  bool valid = false;           ///< false when a vector is zero/non-finite or they are parallel
+  double dip_deg = 0.0;       ///< magnetic inclination (below horizontal: positive in the north)
+  double field_norm_t = 0.0;  ///< |field| (T)
+  bool valid = false;         ///< false when a vector is zero/non-finite or they are parallel
 };
 
 /// Davenport q-method (weighted, optimal in the Wahba sense) on two observations: up (the

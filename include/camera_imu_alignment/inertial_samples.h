@@ -26,16 +26,16 @@ struct MagneticSample {
 
 /// Why an input sample or frame was rejected. Every rejection is counted, never propagated.
 enum class RejectReason {
-  kNonFinite,         ///< NaN or Inf in a value or the stamp
-  kZeroVector,        ///< accelerometer or magnetometer norm (near) zero
-  kStampBackwards,    ///< stamp earlier than the previous sample of the same stream
-  kDuplicateStamp,    ///< stamp equal to the previous sample of the same stream
-  kMagneticUnits,     ///< field norm far outside 20-70 microtesla (gauss or microtesla sent as T?)
-  kBadImage,          ///< empty image, unsupported encoding, size differs from the camera info
-  kBadCameraInfo,     ///< zero/non-finite K, D of a wrong length, unknown distortion model
-  kTargetNotFound,    ///< no (or too little of the) target detected in a frame at rest
-  kPoseRejected,      ///< PnP failed, reprojection error too high or ambiguous planar solution
-  kCount              ///< number of reasons (not a reason)
+  kNonFinite,       ///< NaN or Inf in a value or the stamp
+  kZeroVector,      ///< accelerometer or magnetometer norm (near) zero
+  kStampBackwards,  ///< stamp earlier than the previous sample of the same stream
+  kDuplicateStamp,  ///< stamp equal to the previous sample of the same stream
+  kMagneticUnits,   ///< field norm far outside 20-70 microtesla (gauss or microtesla sent as T?)
+  kBadImage,        ///< empty image, unsupported encoding, size differs from the camera info
+  kBadCameraInfo,   ///< zero/non-finite K, D of a wrong length, unknown distortion model
+  kTargetNotFound,  ///< no (or too little of the) target detected in a frame at rest
+  kPoseRejected,    ///< PnP failed, reprojection error too high or ambiguous planar solution
+  kCount            ///< number of reasons (not a reason)
 };
 
 /// Short snake_case name of a reason ("non_finite", "stamp_backwards", ...), for logs and reports.

@@ -9,10 +9,10 @@ namespace camera_imu_alignment {
 
 /// sensor_msgs/MagneticField is in tesla; the earth's field is 20-70 microtesla.
 enum class FieldUnits {
-  kTesla,          ///< norm within [min, max] microtesla: as specified
-  kLooksLikeGauss, ///< norm 1e4 x too large for tesla, i.e. within 0.2-0.7 (gauss sent as tesla)
+  kTesla,           ///< norm within [min, max] microtesla: as specified
+  kLooksLikeGauss,  ///< norm 1e4 x too large for tesla, i.e. within 0.2-0.7 (gauss sent as tesla)
   kLooksLikeMicrotesla,  ///< norm within 20-70 (microtesla sent as tesla)
-  kOutOfRange,     ///< anything else (zero, disturbed, other unit)
+  kOutOfRange,           ///< anything else (zero, disturbed, other unit)
 };
 
 /// Classifies a field norm (in the message's unit, nominally tesla).
@@ -39,8 +39,8 @@ struct MagnetometerCalibration {
 double fieldDirectionScatterDeg(const std::vector<Eigen::Vector3d>& fields_t);
 
 struct DisturbanceSettings {
-  double max_norm_change = 0.08;   ///< relative change of |B| against the reference
-  double max_dip_change_deg = 3.0; ///< change of the dip angle against the reference
+  double max_norm_change = 0.08;            ///< relative change of |B| against the reference
+  double max_dip_change_deg = 3.0;          ///< change of the dip angle against the reference
   double max_within_segment_std_deg = 1.0;  ///< fieldDirectionScatterDeg inside a segment
 };
 

@@ -23,12 +23,12 @@ struct PoseOrientation {
 /// Keeps the most recent `max_poses` stationary poses (the mount may drift: old poses leave the
 /// window) and forms pairs from them.
 ///
-/// Pair choice: every pair (k, t), k < t, in the window (of the same group). Each pose then informs the estimate
-/// through all the others, large relative rotations are never skipped, and the result does not
-/// depend on pose order (consecutive-only pairs would waste the information between distant poses).
-/// Pairs share poses, so their noise is correlated; each pair carries its pose indices and the
-/// solver's covariance accounts for the correlation. Cost: P (P - 1) / 2 pairs, so the window is
-/// capped.
+/// Pair choice: every pair (k, t), k < t, in the window (of the same group). Each pose then informs
+/// the estimate through all the others, large relative rotations are never skipped, and the result
+/// does not depend on pose order (consecutive-only pairs would waste the information between
+/// distant poses). Pairs share poses, so their noise is correlated; each pair carries its pose
+/// indices and the solver's covariance accounts for the correlation. Cost: P (P - 1) / 2 pairs, so
+/// the window is capped.
 class PoseWindow {
  public:
   explicit PoseWindow(std::size_t max_poses = 30);

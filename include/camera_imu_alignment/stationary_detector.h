@@ -28,12 +28,12 @@
 namespace camera_imu_alignment {
 
 struct StationaryDetectorSettings {
-  double window_s = 1.0;                ///< sliding window length (s)
-  double min_duration_s = 2.0;          ///< shortest segment emitted (s), after trimming
-  double max_gyro_rad_s = 0.03;         ///< |window mean gyro - bias| (rad/s)
+  double window_s = 1.0;                     ///< sliding window length (s)
+  double min_duration_s = 2.0;               ///< shortest segment emitted (s), after trimming
+  double max_gyro_rad_s = 0.03;              ///< |window mean gyro - bias| (rad/s)
   double max_initial_gyro_bias_rad_s = 0.1;  ///< |window mean gyro| before any bias is known
-  double max_gyro_std_rad_s = 0.01;     ///< RMS of |gyro - window mean|, floor (rad/s)
-  double max_accel_std_m_s2 = 0.06;     ///< std of |accel| over the window, floor (m/s^2)
+  double max_gyro_std_rad_s = 0.01;          ///< RMS of |gyro - window mean|, floor (rad/s)
+  double max_accel_std_m_s2 = 0.06;          ///< std of |accel| over the window, floor (m/s^2)
   double noise_factor = 2.0;  ///< limits >= this x the measured noise; 0: fixed limits only
   double max_gravity_error_m_s2 = 0.4;  ///< | |mean accel| - gravity_m_s2 |
   double gravity_m_s2 = 9.81;
@@ -42,7 +42,7 @@ struct StationaryDetectorSettings {
 
 /// One stationary segment with the averages the attitude needs.
 struct StationarySegment {
-  double start_s = 0.0, end_s = 0.0;                       ///< stamps of first / last sample used
+  double start_s = 0.0, end_s = 0.0;  ///< stamps of first / last sample used
   Eigen::Vector3d mean_accel_m_s2 = Eigen::Vector3d::Zero();  ///< IMU frame
   Eigen::Vector3d gyro_bias_rad_s = Eigen::Vector3d::Zero();  ///< mean gyro over the segment
   double accel_norm_std_m_s2 = 0.0;
@@ -75,7 +75,7 @@ class StationaryDetector {
 };
 
 /// Convenience for whole recordings: segments of a sample sequence (stamp order).
-std::vector<StationarySegment> detectStationarySegments(const std::vector<ImuSample>& samples,
-                                                        const StationaryDetectorSettings& settings = {});
+std::vector<StationarySegment> detectStationarySegments(
+    const std::vector<ImuSample>& samples, const StationaryDetectorSettings& settings = {});
 
 }  // namespace camera_imu_alignment

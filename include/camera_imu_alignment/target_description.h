@@ -20,8 +20,8 @@ namespace camera_imu_alignment {
 struct TargetDescription {
   enum class Type { kCheckerboard, kAprilGrid, kCircleGrid };
   Type type = Type::kCheckerboard;
-  int cols = 0;  ///< targetCols (inner corners / circles) or tagCols
-  int rows = 0;  ///< targetRows or tagRows
+  int cols = 0;                ///< targetCols (inner corners / circles) or tagCols
+  int rows = 0;                ///< targetRows or tagRows
   double row_spacing_m = 0.0;  ///< checkerboard rowSpacingMeters; circlegrid spacingMeters
   double col_spacing_m = 0.0;  ///< checkerboard colSpacingMeters; circlegrid spacingMeters
   double tag_size_m = 0.0;     ///< aprilgrid tagSize

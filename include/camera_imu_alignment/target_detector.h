@@ -21,8 +21,8 @@ struct TargetObservation {
 };
 
 struct DetectorSettings {
-  int min_points = 16;         ///< fewer points found: not detected (aprilgrid: >= 4 tags)
-  bool subpixel = true;        ///< checkerboard corner refinement
+  int min_points = 16;   ///< fewer points found: not detected (aprilgrid: >= 4 tags)
+  bool subpixel = true;  ///< checkerboard corner refinement
 };
 
 /// Detects one target type in mono8 images. Checkerboard: cv::findChessboardCornersSB (fallback
@@ -68,7 +68,8 @@ struct PoseSettings {
 /// p_target_cam).
 struct CameraPose {
   Eigen::Matrix3d R_target_cam = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d p_target_cam = Eigen::Vector3d::Zero();  ///< camera centre in the target frame (m)
+  Eigen::Vector3d p_target_cam =
+      Eigen::Vector3d::Zero();  ///< camera centre in the target frame (m)
   double reprojection_rms_px = 0.0;
   double reprojection_mean_px = 0.0;  ///< mean reprojection distance (px)
   double ambiguity_ratio = 0.0;  ///< second-best / best reprojection RMS of the planar solutions

@@ -81,7 +81,8 @@ std::string PipelineSettings::validate() const {
     out << "min_frame_interval_s = " << min_frame_interval_s << ": must be >= 0";
   } else if (window_poses < 2 || window_poses > 200) {
     out << "window_poses = " << window_poses << ": must be within [2, 200]";
-  } else if (min_poses_to_solve < 2 || static_cast<std::size_t>(min_poses_to_solve) > window_poses) {
+  } else if (min_poses_to_solve < 2 ||
+             static_cast<std::size_t>(min_poses_to_solve) > window_poses) {
     out << "min_poses_to_solve = " << min_poses_to_solve << ": must be within [2, window_poses]";
   } else if (min_frames_per_pose < 1 || max_frames_per_pose < min_frames_per_pose) {
     out << "min_frames_per_pose = " << min_frames_per_pose

@@ -36,11 +36,11 @@ struct CalibrationPipeline::Impl {
   double last_imu_stamp = -std::numeric_limits<double>::infinity();
   double last_mag_stamp = -std::numeric_limits<double>::infinity();
   double last_frame_stamp = -std::numeric_limits<double>::infinity();
-  std::deque<ImuSample> imu_buffer;       ///< since the end of the last segment (gyro chain)
-  bool imu_buffer_truncated = false;      ///< samples needed by the next integration were dropped
-  std::deque<MagneticSample> mag_buffer;  ///< calibrated field, tesla
-  std::deque<CameraFrame> frame_queue;    ///< waiting until the IMU shows rest or motion
-  std::vector<FrameDetection> detections; ///< frames at rest with a camera pose
+  std::deque<ImuSample> imu_buffer;        ///< since the end of the last segment (gyro chain)
+  bool imu_buffer_truncated = false;       ///< samples needed by the next integration were dropped
+  std::deque<MagneticSample> mag_buffer;   ///< calibrated field, tesla
+  std::deque<CameraFrame> frame_queue;     ///< waiting until the IMU shows rest or motion
+  std::vector<FrameDetection> detections;  ///< frames at rest with a camera pose
   double last_detection_stamp = -std::numeric_limits<double>::infinity();
   std::uint64_t num_imu = 0, num_mag = 0, num_frames = 0, num_detected = 0;
   std::uint64_t frames_without_intrinsics = 0, frames_dropped = 0;

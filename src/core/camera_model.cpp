@@ -30,7 +30,8 @@ bool CameraIntrinsics::fromCameraInfo(int width, int height, const double K_row_
     c.D.clear();
   } else {
     if (error) {
-      *error = "distortion_model '" + model + "' is not supported (plumb_bob, "
+      *error = "distortion_model '" + model +
+               "' is not supported (plumb_bob, "
                "rational_polynomial, equidistant)";
     }
     return false;
@@ -60,8 +61,7 @@ std::string CameraIntrinsics::validate() const {
     out << "K is zero (camera not calibrated?)";
   } else if (!(K(0, 0) > 0.0) || !(K(1, 1) > 0.0)) {
     out << "K has a non-positive focal length (fx " << K(0, 0) << ", fy " << K(1, 1) << ")";
-  } else if (K(1, 0) != 0.0 || K(2, 0) != 0.0 || K(2, 1) != 0.0 ||
-             std::abs(K(2, 2) - 1.0) > 1e-9) {
+  } else if (K(1, 0) != 0.0 || K(2, 0) != 0.0 || K(2, 1) != 0.0 || std::abs(K(2, 2) - 1.0) > 1e-9) {
     out << "K is not of the form [fx s cx; 0 fy cy; 0 0 1]";
   } else {
     for (double d : D) {
@@ -114,9 +114,9 @@ std::vector<cv::Point2d> CameraIntrinsics::undistortToNormalized(
     cv::fisheye::undistortPoints(in, out, cameraMatrix(), distCoeffs());
   } else {
     // Iterative undistortion; more iterations than the default for strong lenses.
-    cv::undistortPoints(in, out, cameraMatrix(), distCoeffs(), cv::noArray(), cv::noArray(),
-                        cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 50,
-                                         1e-12));
+    cv::undistortPoints(
+        in, out, cameraMatrix(), distCoeffs(), cv::noArray(), cv::noArray(),
+        cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 50, 1e-12));
   }
   return out;
 }

@@ -22,8 +22,9 @@ Eigen::Matrix3d rotationFromRvec(const cv::Mat& rvec) {
 
 /// Reprojection RMS (px) of a pose (rvec, tvec: target -> camera) through the full camera model;
 /// the mean distance (px) in `mean`.
-double reprojectionRms(const std::vector<cv::Point3d>& object, const std::vector<cv::Point2f>& image,
-                       const cv::Mat& rvec, const cv::Mat& tvec, const CameraIntrinsics& camera,
+double reprojectionRms(const std::vector<cv::Point3d>& object,
+                       const std::vector<cv::Point2f>& image, const cv::Mat& rvec,
+                       const cv::Mat& tvec, const CameraIntrinsics& camera,
                        double* mean = nullptr) {
   std::vector<cv::Point2d> projected;
   if (camera.distortion == CameraIntrinsics::Distortion::kEquidistant) {
@@ -70,7 +71,8 @@ std::optional<CameraPose> estimateCameraPose(const TargetObservation& observatio
   }
 
   // IPPE on undistorted normalised points: both planar solutions.
-  const std::vector<cv::Point2d> normalized = intrinsics.undistortToNormalized(observation.image_points);
+  const std::vector<cv::Point2d> normalized =
+      intrinsics.undistortToNormalized(observation.image_points);
   const cv::Mat identity = cv::Mat::eye(3, 3, CV_64F);
   std::vector<cv::Mat> rvecs, tvecs;
   int found = 0;
@@ -88,9 +90,9 @@ std::optional<CameraPose> estimateCameraPose(const TargetObservation& observatio
   int best = -1;
   for (int k = 0; k < found; ++k) {
     cv::Mat rvec = rvecs[k].clone(), tvec = tvecs[k].clone();
-    cv::solvePnPRefineLM(object, normalized, identity, cv::noArray(), rvec, tvec,
-                         cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 50,
-                                          1e-10));
+    cv::solvePnPRefineLM(
+        object, normalized, identity, cv::noArray(), rvec, tvec,
+        cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 50, 1e-10));
     rvecs[k] = rvec, tvecs[k] = tvec;
     if (tvec.at<double>(2) > 0.0) {  // in front of the camera
       rms[k] = reprojectionRms(object, observation.image_points, rvec, tvec, intrinsics);

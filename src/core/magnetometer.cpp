@@ -46,7 +46,8 @@ double fieldDirectionScatterDeg(const std::vector<Eigen::Vector3d>& fields_t) {
   if (!(mean.norm() > 0.0) || !mean.allFinite()) return 0.0;
   double sum_sq = 0.0;
   for (std::size_t k = 0; k < kParts; ++k) {
-    const std::size_t begin = k * fields_t.size() / kParts, end = (k + 1) * fields_t.size() / kParts;
+    const std::size_t begin = k * fields_t.size() / kParts,
+                      end = (k + 1) * fields_t.size() / kParts;
     Eigen::Vector3d part = Eigen::Vector3d::Zero();
     for (std::size_t i = begin; i < end; ++i) part += fields_t[i];
     sum_sq += std::pow(std::atan2(part.cross(mean).norm(), part.dot(mean)), 2);

@@ -21,9 +21,7 @@ struct Key {
 
 template <typename T>
 Key number(const std::string& name, std::function<T*(PipelineSettings*)> field) {
-  return {name, [field](const YAML::Node& node, PipelineSettings* s) {
-            *field(s) = node.as<T>();
-          }};
+  return {name, [field](const YAML::Node& node, PipelineSettings* s) { *field(s) = node.as<T>(); }};
 }
 
 const std::vector<Key>& keys() {
@@ -125,8 +123,8 @@ void parsePipelineConfig(const std::string& text, const std::string& source,
   for (const auto& entry : root) {
     const std::string name = entry.first.as<std::string>();
     if (std::find(ignored_keys.begin(), ignored_keys.end(), name) != ignored_keys.end()) continue;
-    const auto it = std::find_if(keys().begin(), keys().end(),
-                                 [&](const Key& k) { return k.name == name; });
+    const auto it =
+        std::find_if(keys().begin(), keys().end(), [&](const Key& k) { return k.name == name; });
     if (it == keys().end()) {
       throw InputError(source + ": unknown key '" + name + "' (see config/alignment.yaml)");
     }

@@ -77,7 +77,8 @@ Eigen::Matrix3d resolveSymmetry(const Eigen::Matrix3d& R_target_cam,
   }
   std::vector<std::size_t> order(readings.size());
   for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return cost[a] < cost[b]; });
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return cost[a] < cost[b]; });
   if (rad2deg(cost[order[1]] - cost[order[0]]) < kSymmetryMarginDeg) return R_target_cam;
   return readings[order[0]];
 }
@@ -186,7 +187,8 @@ void CalibrationPipeline::Impl::onSegment(const StationarySegment& segment) {
                          std::to_string(settings.min_frames_per_pose) + " needed";
     }
   } else {
-    const RotationAverage average = averageRotations(rotations, 4.0 * settings.max_camera_spread_deg);
+    const RotationAverage average =
+        averageRotations(rotations, 4.0 * settings.max_camera_spread_deg);
     if (average.num_inliers < settings.min_frames_per_pose ||
         average.spread_rms_deg > settings.max_camera_spread_deg) {
       rejection.reason = "camera orientation scatter " + fmt(average.spread_rms_deg) +

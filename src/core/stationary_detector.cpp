@@ -202,8 +202,8 @@ std::optional<double> StationaryDetector::restSince() const {
 
 void StationaryDetector::reset() { impl_ = std::make_shared<Impl>(); }
 
-std::vector<StationarySegment> detectStationarySegments(const std::vector<ImuSample>& samples,
-                                                        const StationaryDetectorSettings& settings) {
+std::vector<StationarySegment> detectStationarySegments(
+    const std::vector<ImuSample>& samples, const StationaryDetectorSettings& settings) {
   StationaryDetector detector(settings);
   std::vector<StationarySegment> segments;
   for (const ImuSample& s : samples) {

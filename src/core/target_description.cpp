@@ -75,7 +75,8 @@ double positiveDouble(const YAML::Node& root, const std::string& key, const std:
     throw InputError(source + ": '" + key + "' is not a number");
   }
   if (!std::isfinite(value) || value < 0.0 || (!allow_zero && value == 0.0)) {
-    throw InputError(source + ": '" + key + "' must be " + (allow_zero ? "non-negative" : "positive"));
+    throw InputError(source + ": '" + key + "' must be " +
+                     (allow_zero ? "non-negative" : "positive"));
   }
   return value;
 }
@@ -104,7 +105,8 @@ TargetDescription parseTargetYaml(const std::string& text, const std::string& so
     t.rows = positiveInt(root, "targetRows", source);
     t.row_spacing_m = positiveDouble(root, "rowSpacingMeters", source);
     t.col_spacing_m = positiveDouble(root, "colSpacingMeters", source);
-    if (t.cols < 2 || t.rows < 2) throw InputError(source + ": a checkerboard needs >= 2x2 corners");
+    if (t.cols < 2 || t.rows < 2)
+      throw InputError(source + ": a checkerboard needs >= 2x2 corners");
   } else if (type == "aprilgrid") {
     t.type = TargetDescription::Type::kAprilGrid;
     t.cols = positiveInt(root, "tagCols", source);

@@ -3,8 +3,8 @@
 // hint and a fixed rule, in that order).
 #include "camera_imu_alignment/target_detector.h"
 
-#include <algorithm>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <opencv2/aruco.hpp>
 #include <opencv2/calib3d.hpp>
@@ -39,7 +39,8 @@ struct Labelling {
 /// Points of a labelled grid, or false when the labelling does not fit the target's shape.
 bool applyLabelling(const std::vector<cv::Point2f>& detected, int det_rows, int det_cols,
                     const Labelling& l, int rows, int cols, std::vector<cv::Point2f>* labelled) {
-  const int out_rows = l.transpose ? det_cols : det_rows, out_cols = l.transpose ? det_rows : det_cols;
+  const int out_rows = l.transpose ? det_cols : det_rows,
+            out_cols = l.transpose ? det_rows : det_cols;
   if (out_rows != rows || out_cols != cols) return false;
   labelled->assign(detected.size(), cv::Point2f());
   for (int i = 0; i < det_rows; ++i) {
@@ -100,8 +101,9 @@ double colourScore(const cv::Mat& mono8, const cv::Mat& H, const TargetDescripti
   int n_white = 0, n_black = 0;
   for (int r = 0; r + 1 < t.rows; ++r) {
     for (int c = 0; c + 1 < t.cols; ++c) {
-      const std::vector<cv::Point2f> centre{cv::Point2f(
-          static_cast<float>((c + 0.5) * t.col_spacing_m), static_cast<float>((r + 0.5) * t.row_spacing_m))};
+      const std::vector<cv::Point2f> centre{
+          cv::Point2f(static_cast<float>((c + 0.5) * t.col_spacing_m),
+                      static_cast<float>((r + 0.5) * t.row_spacing_m))};
       std::vector<cv::Point2f> px;
       cv::perspectiveTransform(centre, px, H);
       const int u = cvRound(px[0].x), v = cvRound(px[0].y);
@@ -215,9 +217,9 @@ bool detectCheckerboard(const cv::Mat& mono8, const TargetDescription& t, bool s
   const cv::Size size(t.cols, t.rows);
   // The classic detector with a fast rejection of frames without a board is quick; the
   // sector-based one finds boards the classic misses (blur, strong perspective).
-  if (!cv::findChessboardCorners(mono8, size, *corners,
-                                 cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE |
-                                     cv::CALIB_CB_FAST_CHECK) &&
+  if (!cv::findChessboardCorners(
+          mono8, size, *corners,
+          cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK) &&
       !cv::findChessboardCornersSB(mono8, size, *corners, cv::CALIB_CB_NORMALIZE_IMAGE)) {
     return false;
   }
@@ -285,8 +287,9 @@ std::vector<Eigen::Matrix3d> TargetDetector::symmetries() const {
       invariant = hit;
     }
     if (!invariant) continue;
-    // ... and, on a checkerboard, the square colours too: colour = parity of the square's lower-left
-    // corner indices; a quarter turn changes that parity by `rows`, a half turn by `cols + rows`.
+    // ... and, on a checkerboard, the square colours too: colour = parity of the square's
+    // lower-left corner indices; a quarter turn changes that parity by `rows`, a half turn by `cols
+    // + rows`.
     if (target_.type == TargetDescription::Type::kCheckerboard) {
       const int parity_change = quarter == 2 ? target_.cols + target_.rows : target_.rows;
       if (parity_change % 2 != 0) continue;

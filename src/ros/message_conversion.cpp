@@ -1,9 +1,9 @@
 #include "camera_imu_alignment/ros/message_conversion.h"
 
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <algorithm>
 #include <cstring>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 
 namespace camera_imu_alignment {

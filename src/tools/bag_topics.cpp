@@ -37,7 +37,8 @@ std::string pick(const std::map<std::string, std::string>& types, const std::str
       if (normalise(c->first) == normalise(requested)) it = c;
     }
     if (it == types.end()) {
-      throw std::runtime_error(std::string(option) + " " + requested + ": no such topic in the bag");
+      throw std::runtime_error(std::string(option) + " " + requested +
+                               ": no such topic in the bag");
     }
     for (const auto& t : wanted_types) {
       if (it->second == t) return it->first;
@@ -82,8 +83,8 @@ BagTopics selectBagTopics(const rosbag::Bag& bag, const BagTopics& requested) {
       topics.image = pick(types, "", {kCompressed}, "image", false, "--image-topic");
     }
   } else {
-    topics.image = pick(types, requested.image, {kImage, kCompressed}, "image", true,
-                        "--image-topic");
+    topics.image =
+        pick(types, requested.image, {kImage, kCompressed}, "image", true, "--image-topic");
   }
   topics.image_compressed = !topics.image.empty() && types[topics.image] == kCompressed;
   // Camera info: the one next to the image topic when there are several.

@@ -9,9 +9,9 @@
 namespace camera_imu_alignment {
 
 struct BagTopics {
-  std::string imu;          ///< sensor_msgs/Imu (required)
-  std::string mag;          ///< sensor_msgs/MagneticField ("" = none)
-  std::string image;        ///< sensor_msgs/Image or CompressedImage ("" = none in the bag)
+  std::string imu;    ///< sensor_msgs/Imu (required)
+  std::string mag;    ///< sensor_msgs/MagneticField ("" = none)
+  std::string image;  ///< sensor_msgs/Image or CompressedImage ("" = none in the bag)
   bool image_compressed = false;
   std::string camera_info;  ///< sensor_msgs/CameraInfo ("" = none)
 };

@@ -19,8 +19,8 @@
 #include "camera_imu_alignment/csv_io.h"
 #include "camera_imu_alignment/pipeline_config.h"
 #include "camera_imu_alignment/result_yaml.h"
-#include "camera_imu_alignment/rotation_math.h"
 #include "camera_imu_alignment/ros/message_conversion.h"
+#include "camera_imu_alignment/rotation_math.h"
 #include "camera_imu_alignment/target_description.h"
 #include "cli_args.h"
 
@@ -105,9 +105,9 @@ class RejectLog {
 
 /// Keys of config/alignment.yaml that only the ROS wrapper reads (topics, frames, files).
 const std::vector<std::string> kRosOnlyKeys = {
-    "camera_frame", "imu_frame", "publish_inverse", "output_file", "target_file", "manual_capture",
-    "min_pose_change_deg", "max_residual_deg", "max_std_dev_deg", "remount_poses",
-    "remount_threshold_deg", "status_rate_hz"};
+    "camera_frame",    "imu_frame",      "publish_inverse",       "output_file",
+    "target_file",     "manual_capture", "min_pose_change_deg",   "max_residual_deg",
+    "max_std_dev_deg", "remount_poses",  "remount_threshold_deg", "status_rate_hz"};
 
 std::string stripSlash(const std::string& frame) {
   return !frame.empty() && frame[0] == '/' ? frame.substr(1) : frame;
@@ -121,8 +121,8 @@ struct RunInfo {
 
 /// Feeds every message of the selected topics to the pipeline. Throws rosbag exceptions on a
 /// corrupt or truncated bag.
-void readBag(const rosbag::Bag& bag, const cia::BagTopics& topics, cia::CalibrationPipeline* pipeline,
-             Progress* progress, RunInfo* info) {
+void readBag(const rosbag::Bag& bag, const cia::BagTopics& topics,
+             cia::CalibrationPipeline* pipeline, Progress* progress, RunInfo* info) {
   std::vector<std::string> names = {topics.imu};
   for (const auto& t : {topics.mag, topics.image, topics.camera_info}) {
     if (!t.empty()) names.push_back(t);
@@ -182,7 +182,6 @@ void readBag(const rosbag::Bag& bag, const cia::BagTopics& topics, cia::Calibrat
   progress->done();
 }
 
-
 /// The whole job; returns the exit code.
 int run(const cia::CliArgs& args) {
   // --- Inputs: target, settings, bag, topics. Each failure names its file, option or topic.
@@ -190,12 +189,14 @@ int run(const cia::CliArgs& args) {
   cia::PipelineSettings settings;
   try {
     target = cia::loadTargetYaml(args.get("--target"));
-    if (args.has("--config")) cia::loadPipelineConfig(args.get("--config"), &settings, kRosOnlyKeys);
+    if (args.has("--config"))
+      cia::loadPipelineConfig(args.get("--config"), &settings, kRosOnlyKeys);
   } catch (const cia::InputError& e) {
     std::cerr << "calibrate_bag: " << e.what() << "\n";
     return kExitBadInput;
   }
-  if (args.has("--method") && !cia::parseSolverMethod(args.get("--method"), &settings.solver.method)) {
+  if (args.has("--method") &&
+      !cia::parseSolverMethod(args.get("--method"), &settings.solver.method)) {
     std::cerr << "calibrate_bag: --method " << args.get("--method")
               << ": must be optimal or two_step\n";
     return kExitBadInput;
@@ -247,8 +248,8 @@ int run(const cia::CliArgs& args) {
     readBag(bag, topics, &pipeline, &progress, &info);
   } catch (const std::exception& e) {
     progress.done();
-    std::cerr << "calibrate_bag: " << bag_path << ": cannot read the bag to the end ("
-              << e.what() << "); truncated or corrupt? 'rosbag reindex' may repair it\n";
+    std::cerr << "calibrate_bag: " << bag_path << ": cannot read the bag to the end (" << e.what()
+              << "); truncated or corrupt? 'rosbag reindex' may repair it\n";
     return kExitBadInput;
   }
 
@@ -264,7 +265,8 @@ int run(const cia::CliArgs& args) {
   }
   if (!pipeline.hasIntrinsics()) {
     std::cerr << "calibrate_bag: " << bag_path << ": no usable camera info ("
-              << (topics.camera_info.empty() ? "no sensor_msgs/CameraInfo topic" : topics.camera_info)
+              << (topics.camera_info.empty() ? "no sensor_msgs/CameraInfo topic"
+                                             : topics.camera_info)
               << "); PnP needs the intrinsics\n";
     return kExitBadInput;
   }

@@ -24,8 +24,9 @@ MagneticSample toMagneticSample(const sensor_msgs::MagneticField& msg);
 /// K, D, distortion_model, size; false with `error` when unusable (zero K, wrong D length, ...).
 bool toCameraIntrinsics(const sensor_msgs::CameraInfo& msg, CameraIntrinsics* intrinsics,
                         std::string* error);
-/// mono8 / 8UC1 (shared), mono16 / 16UC1 (scaled so that the brightest pixel is 255: 10/12-bit data too), rgb8, bgr8, rgba8, bgra8 (to grey).
-/// False with `error` for other encodings or when step/size/data length disagree.
+/// mono8 / 8UC1 (shared), mono16 / 16UC1 (scaled so that the brightest pixel is 255: 10/12-bit data
+/// too), rgb8, bgr8, rgba8, bgra8 (to grey). False with `error` for other encodings or when
+/// step/size/data length disagree.
 bool toMono8(const sensor_msgs::Image& msg, cv::Mat* mono8, std::string* error);
 /// JPEG/PNG payload of a CompressedImage (any format cv::imdecode reads), decoded to grey.
 bool toMono8(const sensor_msgs::CompressedImage& msg, cv::Mat* mono8, std::string* error);
