@@ -25,8 +25,8 @@ struct DetectorSettings {
   bool subpixel = true;  ///< checkerboard corner refinement
 };
 
-/// Detects one target type in mono8 images. Checkerboard: cv::findChessboardCornersSB (fallback
-/// findChessboardCorners + cornerSubPix), corners re-ordered so that index 0 is always the target
+/// Detects one target type in mono8 images. Checkerboard: cv::findChessboardCorners with a fast
+/// rejection (fallback findChessboardCornersSB for blurred or oblique views) + cornerSubPix, corners re-ordered so that index 0 is always the target
 /// origin (the 180-degree ambiguity is resolved by the square colours where the board allows it,
 /// otherwise by the orientation closest to `hint`); AprilGrid: tag36h11 via OpenCV aruco, Kalibr's
 /// layout, partial views allowed; circle grid: cv::findCirclesGrid (symmetric/asymmetric).
