@@ -16,7 +16,9 @@ export ROS_HOME="${WS}/ros_home"
 CIA_PACKAGES=(
   build-essential cmake catkin ros-base-dev rosbash python3-rostest python3-rosbag
   libeigen3-dev libopencv-dev libopencv-contrib-dev libyaml-cpp-dev libgtest-dev libbenchmark-dev
-  librosbag-dev libsensor-msgs-dev libstd-msgs-dev catkin-lint clang-format
+  librosbag-dev libsensor-msgs-dev libstd-msgs-dev libgeometry-msgs-dev libstd-srvs-dev
+  libnodelet-dev libimage-transport-dev libtf2-ros-dev libdiagnostic-updater-dev tf2-tools
+  catkin-lint clang-format
 )
 
 cia_log() { echo "[camera_imu_alignment] $*" >&2; }

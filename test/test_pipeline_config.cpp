@@ -1,4 +1,4 @@
-// config/alignment.yaml documents every setting with its default: it must load, know every key,
+// config/default.yaml documents every setting with its default: it must load, know every key,
 // and equal the built-in defaults. Bad files are refused with the file and key named.
 #include <gtest/gtest.h>
 
@@ -7,12 +7,13 @@
 
 #include "camera_imu_alignment/csv_io.h"
 #include "camera_imu_alignment/pipeline_config.h"
+#include "camera_imu_alignment/ros/wrapper_settings.h"
 #include "test_helpers.h"
 
 namespace camera_imu_alignment {
 namespace {
 
-std::string configPath() { return std::string(PACKAGE_SOURCE_DIR) + "/config/alignment.yaml"; }
+std::string configPath() { return std::string(PACKAGE_SOURCE_DIR) + "/config/default.yaml"; }
 
 /// Settings with every configurable value changed, to see that loading overwrites each of them.
 PipelineSettings scrambled() {
@@ -90,8 +91,32 @@ void expectDefaults(const PipelineSettings& s) {
 
 TEST(PipelineConfig, DocumentedDefaultsEqualTheBuiltInOnes) {
   PipelineSettings loaded = scrambled();
-  ASSERT_NO_THROW(loadPipelineConfig(configPath(), &loaded));
+  ASSERT_NO_THROW(loadPipelineConfig(configPath(), &loaded, wrapperKeys()));
   expectDefaults(loaded);
+  // The wrapper's section too (target_file is required and has no default).
+  std::ifstream in(configPath());
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  WrapperSettings w;
+  w.min_poses = 7, w.max_residual_deg = 7, w.max_std_dev_deg = 7, w.min_change_deg = 7;
+  w.remount_poses = 7, w.remount_residual_deg = 7, w.status_period_s = 7;
+  w.publish_inverse = true, w.load_on_start = false, w.manual_capture = true;
+  PipelineSettings p;
+  EXPECT_THROW(parseSettings(text, "default.yaml", &w, &p), InputError);  // target_file: ""
+  ASSERT_NO_THROW(parseSettings(text + "target_file: t.yaml\n", "default.yaml", &w, &p));
+  const WrapperSettings d;
+  EXPECT_EQ(w.min_poses, d.min_poses);
+  EXPECT_EQ(w.max_residual_deg, d.max_residual_deg);
+  EXPECT_EQ(w.max_std_dev_deg, d.max_std_dev_deg);
+  EXPECT_EQ(w.min_change_deg, d.min_change_deg);
+  EXPECT_EQ(w.remount_poses, d.remount_poses);
+  EXPECT_EQ(w.remount_residual_deg, d.remount_residual_deg);
+  EXPECT_EQ(w.status_period_s, d.status_period_s);
+  EXPECT_EQ(w.publish_inverse, d.publish_inverse);
+  EXPECT_EQ(w.load_on_start, d.load_on_start);
+  EXPECT_EQ(w.manual_capture, d.manual_capture);
+  EXPECT_EQ(w.camera_frame, d.camera_frame);
+  EXPECT_EQ(w.output_file, d.output_file);
+  EXPECT_EQ(w.image_transport, d.image_transport);
 }
 
 TEST(PipelineConfig, EveryKnownKeyIsDocumented) {
@@ -103,7 +128,8 @@ TEST(PipelineConfig, EveryKnownKeyIsDocumented) {
     documented.insert(line.substr(0, colon));
   }
   for (const auto& key : pipelineConfigKeys()) EXPECT_TRUE(documented.count(key)) << key;
-  EXPECT_EQ(documented.size(), pipelineConfigKeys().size());
+  for (const auto& key : wrapperKeys()) EXPECT_TRUE(documented.count(key)) << key;
+  EXPECT_EQ(documented.size(), pipelineConfigKeys().size() + wrapperKeys().size());
 }
 
 void expectRefused(const std::string& text, const std::string& expected_in_message) {
@@ -131,6 +157,25 @@ TEST(PipelineConfig, BadFilesAreRefusedNamingTheKey) {
   expectRefused("accel_weight: 1.5\n", "accel_weight");
   expectRefused("- a list\n", "map");
   expectRefused("frame_margin_s: .nan\n", "frame_margin_s");
+}
+
+TEST(WrapperSettings, BadParametersAreRefusedNamingThem) {
+  auto refused = [](const std::string& text, const std::string& expected) {
+    WrapperSettings w;
+    PipelineSettings p;
+    try {
+      parseSettings("target_file: t.yaml\n" + text, "params", &w, &p);
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  refused("min_poses: 1\n", "min_poses");
+  refused("max_std_dev_deg: 0\n", "max_std_dev_deg");
+  refused("remount_residual_deg: -2\n", "remount_residual_deg");
+  refused("publish_inverse: maybe\n", "publish_inverse");
+  refused("window_poses: 1\n", "window_poses");
+  refused("camera_frme: cam\n", "unknown key 'camera_frme'");
 }
 
 TEST(PipelineConfig, RosOnlyKeysCanBeSkippedAndPartialFilesKeepTheRest) {

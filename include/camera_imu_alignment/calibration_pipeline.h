@@ -81,7 +81,7 @@ struct PipelineSettings {
   double frame_queue_s = 3.0;          ///< frames older than the IMU by more are dropped (no IMU)
   double accel_weight = 0.9;           ///< attitudeFromAccelMag
   /// Returns an empty string when usable, else the first unusable setting, named by its key in
-  /// config/alignment.yaml.
+  /// config/default.yaml.
   std::string validate() const;
 };
 
@@ -138,8 +138,12 @@ class CalibrationPipeline {
   void finish();
   /// Solves on the current window (also done automatically after every new pose).
   AlignmentResult solve() const;
-  /// Forgets everything (window, buffers, counts kept unless clear_counts).
+  /// Forgets all data (poses, window, buffers; counts kept unless clear_counts); the camera
+  /// intrinsics stay. Not from a callback.
   void reset(bool clear_counts = false);
+  /// Keeps only the newest `count` poses in the solver's window (a remount); callbacks may call it.
+  void keepNewestPoses(std::size_t count);
+  std::size_t windowSize() const;  ///< poses in the solver's window
 
   const std::vector<StationaryPose>& poses() const;  ///< all poses so far
   RotationPairs windowPairs() const;  ///< the pairs solve() uses (poses in the window)

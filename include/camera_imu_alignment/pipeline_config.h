@@ -1,5 +1,5 @@
 // PipelineSettings from a flat YAML map whose keys are the node's private parameter names
-// (config/alignment.yaml documents every key with its default and unit). calibrate_bag --config
+// (config/default.yaml documents every key with its default and unit). calibrate_bag --config
 // and the nodelet read the same keys, so one file configures both.
 #pragma once
 

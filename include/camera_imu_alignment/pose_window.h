@@ -37,6 +37,8 @@ class PoseWindow {
   /// when an orientation is not a finite rotation matrix.
   bool add(const PoseOrientation& pose);
   void clear();
+  /// Drops all but the newest `count` poses (a remount: the older ones describe the old mount).
+  void keepNewest(std::size_t count);
   std::size_t size() const { return poses_.size(); }
   std::size_t maxPoses() const { return max_poses_; }
   const std::deque<PoseOrientation>& poses() const { return poses_; }

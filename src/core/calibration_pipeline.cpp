@@ -286,7 +286,9 @@ void CalibrationPipeline::reset(bool clear_counts) {
   const RejectionCounts counts = impl_->rejections;
   const std::uint64_t n_imu = impl_->num_imu, n_mag = impl_->num_mag, n_frames = impl_->num_frames,
                       n_detected = impl_->num_detected;
+  const std::optional<CameraIntrinsics> intrinsics = impl_->intrinsics;
   impl_ = std::make_unique<Impl>(impl_->target, impl_->settings, impl_->callbacks);
+  impl_->intrinsics = intrinsics;  // configuration, not data: kept
   if (!clear_counts) {
     impl_->rejections = counts;
     impl_->num_imu = n_imu;
@@ -295,6 +297,9 @@ void CalibrationPipeline::reset(bool clear_counts) {
     impl_->num_detected = n_detected;
   }
 }
+
+void CalibrationPipeline::keepNewestPoses(std::size_t count) { impl_->window.keepNewest(count); }
+std::size_t CalibrationPipeline::windowSize() const { return impl_->window.size(); }
 
 const std::vector<StationaryPose>& CalibrationPipeline::poses() const { return impl_->poses; }
 RotationPairs CalibrationPipeline::windowPairs() const { return impl_->window.makePairs(); }

@@ -126,7 +126,7 @@ void parsePipelineConfig(const std::string& text, const std::string& source,
     const auto it =
         std::find_if(keys().begin(), keys().end(), [&](const Key& k) { return k.name == name; });
     if (it == keys().end()) {
-      throw InputError(source + ": unknown key '" + name + "' (see config/alignment.yaml)");
+      throw InputError(source + ": unknown key '" + name + "' (see config/default.yaml)");
     }
     try {
       it->read(entry.second, &updated);

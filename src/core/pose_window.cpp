@@ -19,6 +19,10 @@ bool PoseWindow::add(const PoseOrientation& pose) {
 
 void PoseWindow::clear() { poses_.clear(); }
 
+void PoseWindow::keepNewest(std::size_t count) {
+  while (poses_.size() > count) poses_.pop_front();
+}
+
 RotationPairs PoseWindow::makePairs() const {
   return makeAllPairs(std::vector<PoseOrientation>(poses_.begin(), poses_.end()));
 }

@@ -20,6 +20,7 @@
 #include "camera_imu_alignment/pipeline_config.h"
 #include "camera_imu_alignment/result_yaml.h"
 #include "camera_imu_alignment/ros/message_conversion.h"
+#include "camera_imu_alignment/ros/wrapper_settings.h"
 #include "camera_imu_alignment/rotation_math.h"
 #include "camera_imu_alignment/target_description.h"
 #include "cli_args.h"
@@ -41,7 +42,7 @@ const char* kUsage =
     "  --bag FILE.bag        ROS 1 bag: sensor_msgs/Imu, optional MagneticField, Image or\n"
     "                        CompressedImage and CameraInfo (topics found by type when not given)\n"
     "  --target TARGET.yaml  Kalibr target file (checkerboard, aprilgrid, circlegrid)\n"
-    "  --config PARAMS.yaml  settings, keys as in config/alignment.yaml\n"
+    "  --config PARAMS.yaml  settings, keys as in config/default.yaml\n"
     "  --method M            optimal (default) or two_step (the paper's iteration alone)\n"
     "  --imu-orientation S   auto (default: gyro between poses) or magnetometer (the paper's)\n"
     "  --output RESULT.yaml  write the result YAML (shared/CONVENTIONS.md) there\n"
@@ -102,12 +103,6 @@ class RejectLog {
  private:
   std::map<cia::RejectReason, int> shown_;
 };
-
-/// Keys of config/alignment.yaml that only the ROS wrapper reads (topics, frames, files).
-const std::vector<std::string> kRosOnlyKeys = {
-    "camera_frame",    "imu_frame",      "publish_inverse",       "output_file",
-    "target_file",     "manual_capture", "min_pose_change_deg",   "max_residual_deg",
-    "max_std_dev_deg", "remount_poses",  "remount_threshold_deg", "status_rate_hz"};
 
 std::string stripSlash(const std::string& frame) {
   return !frame.empty() && frame[0] == '/' ? frame.substr(1) : frame;
@@ -190,7 +185,7 @@ int run(const cia::CliArgs& args) {
   try {
     target = cia::loadTargetYaml(args.get("--target"));
     if (args.has("--config"))
-      cia::loadPipelineConfig(args.get("--config"), &settings, kRosOnlyKeys);
+      cia::loadPipelineConfig(args.get("--config"), &settings, cia::wrapperKeys());
   } catch (const cia::InputError& e) {
     std::cerr << "calibrate_bag: " << e.what() << "\n";
     return kExitBadInput;

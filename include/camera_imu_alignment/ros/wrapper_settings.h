@@ -1,0 +1,49 @@
+// Settings of the ROS wrapper (topics are remapped, not configured), read together with the
+// pipeline's from the node's private parameters. config/default.yaml documents every key.
+#pragma once
+
+#include <ros/node_handle.h>
+
+#include <string>
+#include <vector>
+
+#include "camera_imu_alignment/calibration_pipeline.h"
+
+namespace camera_imu_alignment {
+
+struct WrapperSettings {
+  std::string target_file;       ///< Kalibr target YAML (required)
+  std::string camera_frame;      ///< tf frame of the camera; "" = the image header's frame_id
+  std::string imu_frame;         ///< tf frame of the IMU; "" = the Imu header's frame_id
+  bool publish_inverse = false;  ///< broadcast imu -> camera (parent IMU) instead of camera -> imu
+  std::string output_file;       ///< each accepted calibration is written here ("" = not saved)
+  bool load_on_start = true;     ///< broadcast output_file's calibration at start if it exists
+  // Quality gates: an estimate is broadcast only when observable and all of these hold.
+  int min_poses = 3;              ///< stationary poses in the window
+  double max_residual_deg = 1.0;  ///< RMS pair residual (deg)
+  double max_std_dev_deg = 0.5;   ///< largest 1-sigma (deg)
+  double min_change_deg = 0.01;   ///< re-broadcast only when the estimate moved more (deg)
+  bool manual_capture = false;    ///< poses only from rests during which ~capture_pose was called
+  // Remount: this many consecutive new poses whose pairs with the window disagree with the
+  // broadcast estimate by more than remount_residual_deg (RMS) restart the window from them.
+  int remount_poses = 3;
+  double remount_residual_deg = 1.5;
+  double status_period_s = 1.0;  ///< ~status is also published this often (s)
+  /// image_transport's own parameter: "raw", or "compressed" for CompressedImage topics.
+  std::string image_transport = "raw";
+};
+
+/// The wrapper's own keys (the pipeline's are pipelineConfigKeys()).
+const std::vector<std::string>& wrapperKeys();
+
+/// Reads the private parameters of `private_nh`: wrapper keys into `wrapper`, pipeline keys into
+/// `pipeline` (same reader and checks as calibrate_bag --config). Throws InputError naming the
+/// parameter on an unknown key, a wrong type or an unusable value.
+void readSettings(const ros::NodeHandle& private_nh, WrapperSettings* wrapper,
+                  PipelineSettings* pipeline);
+
+/// Same from YAML text (the parameters as a flat map); `source` names it in messages.
+void parseSettings(const std::string& yaml_text, const std::string& source,
+                   WrapperSettings* wrapper, PipelineSettings* pipeline);
+
+}  // namespace camera_imu_alignment

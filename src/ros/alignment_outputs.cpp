@@ -1,0 +1,291 @@
+// AlignmentWrapper, output side: quality gates, the static tf, ~status, ~stationary_poses, the
+// saved calibration, services and diagnostics.
+#include <geometry_msgs/PoseArray.h>
+#include <geometry_msgs/TransformStamped.h>
+
+#include <Eigen/Geometry>
+#include <filesystem>
+#include <sstream>
+
+#include "alignment_wrapper_impl.h"
+#include "camera_imu_alignment/AlignmentStatus.h"
+#include "camera_imu_alignment/calibration_report.h"
+#include "camera_imu_alignment/csv_io.h"
+#include "camera_imu_alignment/result_yaml.h"
+#include "camera_imu_alignment/rotation_math.h"
+
+namespace camera_imu_alignment {
+namespace {
+
+geometry_msgs::Quaternion toMsg(const Eigen::Matrix3d& R) {
+  const Eigen::Quaterniond q(R);
+  geometry_msgs::Quaternion out;
+  out.x = q.x(), out.y = q.y(), out.z = q.z(), out.w = q.w();
+  return out;
+}
+
+std::string fixed(double value, int precision) {
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(precision);
+  out << value;
+  return out.str();
+}
+
+}  // namespace
+
+void AlignmentWrapper::Impl::advertise() {
+  status_pub = pnh.advertise<AlignmentStatus>("status", 10, true);
+  poses_pub = pnh.advertise<geometry_msgs::PoseArray>("stationary_poses", 1, true);
+  calibrate_srv = pnh.advertiseService("calibrate", &Impl::onCalibrate, this);
+  reset_srv = pnh.advertiseService("reset", &Impl::onReset, this);
+  save_srv = pnh.advertiseService("save", &Impl::onSave, this);
+  capture_srv = pnh.advertiseService("capture_pose", &Impl::onCapturePose, this);
+  status_timer = pnh.createTimer(ros::Duration(settings.status_period_s), [this](const auto&) {
+    publishStatus();
+    diagnostics.update();
+  });
+  diagnostics.setHardwareID("camera_imu_alignment");
+  diagnostics.add("calibration", this, &Impl::diagnose);
+}
+
+std::string AlignmentWrapper::Impl::cameraFrame() const {
+  if (!settings.camera_frame.empty()) return settings.camera_frame;
+  return image_frame.empty() ? "camera_optical_frame" : image_frame;
+}
+
+std::string AlignmentWrapper::Impl::imuFrame() const {
+  if (!settings.imu_frame.empty()) return settings.imu_frame;
+  return imu_msg_frame.empty() ? "imu_link" : imu_msg_frame;
+}
+
+bool AlignmentWrapper::Impl::passesGates(const AlignmentResult& r, std::string* why) const {
+  std::ostringstream out;
+  const int poses = static_cast<int>(pipeline->windowSize());
+  const double sigma = r.quality.std_dev_deg.maxCoeff();
+  if (r.status != SolveStatus::kOk) {
+    out << r.message;
+  } else if (poses < settings.min_poses) {
+    out << poses << " poses in the window, min_poses is " << settings.min_poses;
+  } else if (r.quality.residual_rms_deg > settings.max_residual_deg) {
+    out << "residual RMS " << fixed(r.quality.residual_rms_deg, 3) << " deg > max_residual_deg "
+        << settings.max_residual_deg;
+  } else if (sigma > settings.max_std_dev_deg) {
+    out << "1-sigma " << fixed(sigma, 3) << " deg > max_std_dev_deg " << settings.max_std_dev_deg
+        << ": more poses, rotated about other axes";
+  }
+  *why = out.str();
+  return why->empty();
+}
+
+void AlignmentWrapper::Impl::onResult(const AlignmentResult& result) {
+  last_result = result;
+  std::string why;
+  if (!passesGates(result, &why)) {
+    state = result.status == SolveStatus::kNotObservable ? "not_observable"
+            : recalibrating                              ? "recalibrating"
+                                                         : "collecting";
+    state_message = why;
+    ROS_INFO_THROTTLE(2.0, "camera_imu_alignment: estimate not broadcast: %s", why.c_str());
+    publishStatus();
+    return;
+  }
+  accepted_result = result;
+  recalibrating = false;
+  state = "calibrated";
+  state_message = result.message;
+  const bool moved =
+      !broadcast_R ||
+      rad2deg(rotationAngle(broadcast_R->transpose() * result.R_cam_imu)) > settings.min_change_deg;
+  if (moved) {
+    broadcast(result.R_cam_imu);
+    std::string error;
+    if (!settings.output_file.empty() && !save(result, &error)) {
+      ROS_ERROR_THROTTLE(10.0, "camera_imu_alignment: %s", error.c_str());
+    }
+  }
+  publishStatus();
+}
+
+void AlignmentWrapper::Impl::broadcast(const Eigen::Matrix3d& R_cam_imu) {
+  geometry_msgs::TransformStamped t;
+  t.header.stamp = ros::Time::now();
+  // A transform parent <- child maps child-frame points into the parent frame.
+  if (settings.publish_inverse) {
+    t.header.frame_id = imuFrame();
+    t.child_frame_id = cameraFrame();
+    t.transform.rotation = toMsg(R_cam_imu.transpose());
+  } else {
+    t.header.frame_id = cameraFrame();
+    t.child_frame_id = imuFrame();
+    t.transform.rotation = toMsg(R_cam_imu);
+  }
+  broadcaster.sendTransform(t);
+  broadcast_R = R_cam_imu;
+  inconsistent_poses = 0;  // the remount check starts over against the new estimate
+  const Eigen::Vector3d rpy = rollPitchYawDeg(R_cam_imu);
+  ROS_INFO("camera_imu_alignment: broadcasting %s -> %s, R_cam_imu rpy [%.3f, %.3f, %.3f] deg",
+           t.header.frame_id.c_str(), t.child_frame_id.c_str(), rpy.x(), rpy.y(), rpy.z());
+}
+
+bool AlignmentWrapper::Impl::save(const AlignmentResult& result, std::string* error) {
+  try {
+    ResultMetadata meta{cameraFrame(), imuFrame(), static_cast<int>(pipeline->windowSize())};
+    writeResultYaml(settings.output_file, result, meta);
+    return true;
+  } catch (const std::exception& e) {
+    *error = std::string("cannot save the calibration: ") + e.what();
+    return false;
+  }
+}
+
+void AlignmentWrapper::Impl::loadSaved() {
+  if (settings.output_file.empty() || !std::filesystem::exists(settings.output_file)) return;
+  try {
+    const StoredCalibration stored = readResultYaml(settings.output_file);
+    if (settings.camera_frame.empty()) image_frame = stored.camera_frame;
+    if (settings.imu_frame.empty()) imu_msg_frame = stored.imu_frame;
+    broadcast(stored.R_cam_imu);
+    state = "calibrated";
+    state_message = "calibration loaded from " + settings.output_file;
+    ROS_INFO("camera_imu_alignment: %s", state_message.c_str());
+  } catch (const std::exception& e) {
+    ROS_WARN("camera_imu_alignment: saved calibration not loaded: %s", e.what());
+  }
+}
+
+void AlignmentWrapper::Impl::publishStatus() {
+  AlignmentStatus s;
+  s.header.stamp = last_stamp_s > 0.0 ? ros::Time(last_stamp_s) : ros::Time::now();
+  s.header.frame_id = cameraFrame();
+  if (state == "waiting_for_data" && pipeline->imuSamples() > 0 && pipeline->hasIntrinsics()) {
+    state = "collecting";
+    state_message = "waiting for stationary poses";
+  }
+  s.state = state;
+  s.message = state_message;
+  s.poses_in_window = static_cast<std::uint32_t>(pipeline->windowSize());
+  s.poses_total = static_cast<std::uint32_t>(pipeline->poses().size());
+  const AlignmentResult* r = last_result ? &*last_result : nullptr;
+  s.q_cam_imu.w = 1.0;
+  if (r) {
+    s.pairs = static_cast<std::uint32_t>(r->quality.num_pairs);
+    s.inliers = static_cast<std::uint32_t>(r->quality.num_inliers);
+    s.has_estimate = true;
+    s.q_cam_imu = toMsg(r->R_cam_imu);
+    s.residual_rms_deg = r->quality.residual_rms_deg;
+    for (int i = 0; i < 3; ++i) s.std_dev_deg[i] = r->quality.std_dev_deg(i);
+    s.observability = r->quality.observability;
+    s.rotate_about_cam.x = r->quality.excite_axis_cam.x();
+    s.rotate_about_cam.y = r->quality.excite_axis_cam.y();
+    s.rotate_about_cam.z = r->quality.excite_axis_cam.z();
+    s.broadcast =
+        broadcast_R && rad2deg(rotationAngle(broadcast_R->transpose() * r->R_cam_imu)) <= 1e-9;
+  }
+  if (last_pose) {
+    s.last_pose_start = ros::Time(last_pose->start_s);
+    s.last_pose_end = ros::Time(last_pose->end_s);
+    s.last_pose_frames = static_cast<std::uint32_t>(last_pose->num_frames);
+    s.last_pose_imu_source = last_pose->imu_source;
+  }
+  status_pub.publish(s);
+}
+
+void AlignmentWrapper::Impl::publishPoses() {
+  // Camera orientations at the poses, in the target frame (rviz: fixed frame = the target).
+  geometry_msgs::PoseArray out;
+  out.header.stamp = ros::Time(last_stamp_s > 0.0 ? last_stamp_s : 0.0);
+  out.header.frame_id = "calibration_target";
+  for (const StationaryPose& p : pipeline->poses()) {
+    geometry_msgs::Pose pose;
+    pose.position.x = p.p_target_cam.x();
+    pose.position.y = p.p_target_cam.y();
+    pose.position.z = p.p_target_cam.z();
+    pose.orientation = toMsg(p.R_target_cam);
+    out.poses.push_back(pose);
+  }
+  poses_pub.publish(out);
+}
+
+bool AlignmentWrapper::Impl::onCalibrate(Calibrate::Request&, Calibrate::Response& res) {
+  const AlignmentResult r = pipeline->solve();
+  res.poses = static_cast<std::uint32_t>(pipeline->windowSize());
+  res.observable = r.quality.observable && r.status != SolveStatus::kBadInput;
+  res.success = r.status == SolveStatus::kOk;
+  res.message = r.message;
+  if (r.status != SolveStatus::kBadInput) {
+    res.q_cam_imu = toMsg(r.R_cam_imu);
+    const Eigen::Vector3d rpy = rollPitchYawDeg(r.R_cam_imu);
+    for (int i = 0; i < 3; ++i) {
+      res.rpy_deg[i] = rpy(i);
+      res.std_dev_deg[i] = r.quality.std_dev_deg(i);
+    }
+    res.residual_rms_deg = r.quality.residual_rms_deg;
+    onResult(r);  // gates, broadcast, save, status
+  } else {
+    res.q_cam_imu.w = 1.0;
+  }
+  return true;
+}
+
+bool AlignmentWrapper::Impl::onReset(std_srvs::Trigger::Request&,
+                                     std_srvs::Trigger::Response& res) {
+  pipeline->reset();
+  last_result.reset();
+  last_pose.reset();
+  inconsistent_poses = 0;
+  recalibrating = false;
+  state = broadcast_R ? "collecting" : "waiting_for_data";
+  state_message =
+      "reset: window and buffers cleared" +
+      std::string(broadcast_R ? "; the broadcast calibration stays until a new one" : "");
+  res.success = true;
+  res.message = state_message;
+  publishStatus();
+  return true;
+}
+
+bool AlignmentWrapper::Impl::onSave(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  if (settings.output_file.empty()) {
+    res.success = false;
+    res.message = "no output_file parameter set";
+  } else if (!accepted_result) {
+    res.success = false;
+    res.message = "no calibration has passed the quality gates yet";
+  } else {
+    std::string error;
+    res.success = save(*accepted_result, &error);
+    res.message = res.success ? "saved to " + settings.output_file : error;
+  }
+  return true;
+}
+
+bool AlignmentWrapper::Impl::onCapturePose(std_srvs::Trigger::Request&,
+                                           std_srvs::Trigger::Response& res) {
+  if (!settings.manual_capture) {
+    res.success = false;
+    res.message = "manual_capture is false: every rest becomes a pose automatically";
+    return true;
+  }
+  capture_armed = true;
+  res.success = true;
+  res.message = "armed: the current (or next) rest becomes a pose when the rig moves again";
+  return true;
+}
+
+void AlignmentWrapper::Impl::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  using diagnostic_msgs::DiagnosticStatus;
+  const unsigned char level = state == "calibrated"       ? DiagnosticStatus::OK
+                              : state == "not_observable" ? DiagnosticStatus::WARN
+                              : state == "recalibrating"  ? DiagnosticStatus::WARN
+                                                          : DiagnosticStatus::OK;
+  status.summary(level, state + ": " + state_message);
+  status.add("imu samples", pipeline->imuSamples());
+  status.add("magnetometer samples", pipeline->magneticSamples());
+  status.add("frames", pipeline->frames());
+  status.add("frames detected", pipeline->framesDetected());
+  status.add("poses in window", pipeline->windowSize());
+  status.add("rejected inputs", pipeline->rejections().summary());
+}
+
+}  // namespace camera_imu_alignment

@@ -1,0 +1,89 @@
+// Private state of AlignmentWrapper, shared by its two source files (inputs and pipeline:
+// alignment_wrapper.cpp; gates, tf, status, files, services: alignment_outputs.cpp). Not installed.
+#pragma once
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <image_transport/image_transport.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/Imu.h>
+#include <sensor_msgs/MagneticField.h>
+#include <std_srvs/Trigger.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+
+#include <memory>
+#include <optional>
+
+#include "camera_imu_alignment/Calibrate.h"
+#include "camera_imu_alignment/calibration_pipeline.h"
+#include "camera_imu_alignment/ros/alignment_wrapper.h"
+#include "camera_imu_alignment/ros/wrapper_settings.h"
+
+namespace camera_imu_alignment {
+
+struct AlignmentWrapper::Impl {
+  Impl(ros::NodeHandle nh, ros::NodeHandle private_nh);
+
+  ros::NodeHandle nh, pnh;
+  WrapperSettings settings;
+  PipelineSettings pipeline_settings;
+  std::unique_ptr<CalibrationPipeline> pipeline;
+
+  // --- inputs
+  image_transport::ImageTransport transport;
+  ros::Subscriber imu_sub, mag_sub;
+  image_transport::CameraSubscriber camera_sub;
+  std::string image_frame, imu_msg_frame;  ///< frame_ids seen on the inputs
+  sensor_msgs::CameraInfo last_info;       ///< the intrinsics in use
+  double last_stamp_s = -1.0;              ///< newest input stamp (clock jumps)
+  bool reset_requested = false;            ///< applied after the pipeline call returns
+  bool capture_armed = false;              ///< manual_capture: ~capture_pose called for this rest
+  void onImu(const sensor_msgs::ImuConstPtr& msg);
+  void onMag(const sensor_msgs::MagneticFieldConstPtr& msg);
+  void onImage(const sensor_msgs::ImageConstPtr& image,
+               const sensor_msgs::CameraInfoConstPtr& info);
+  /// Stamp check shared by the inputs: a jump back by more than a second (a bag loop) resets the
+  /// buffers with a warning. False when the message is to be dropped.
+  bool acceptStamp(const ros::Time& stamp, const char* topic);
+  void applyPendingReset();
+
+  // --- pipeline callbacks
+  void onPose(const StationaryPose& pose);
+  void onPoseRejected(const RejectedPose& rejected);
+  void onResult(const AlignmentResult& result);
+  void onReject(RejectReason reason, const std::string& detail);
+  int inconsistent_poses = 0;  ///< consecutive poses that disagree with the broadcast estimate
+
+  // --- outputs (alignment_outputs.cpp)
+  tf2_ros::StaticTransformBroadcaster broadcaster;
+  ros::Publisher status_pub, poses_pub;
+  ros::ServiceServer calibrate_srv, reset_srv, save_srv, capture_srv;
+  ros::Timer status_timer;
+  diagnostic_updater::Updater diagnostics;
+  std::optional<AlignmentResult> last_result;      ///< latest solve
+  std::optional<Eigen::Matrix3d> broadcast_R;      ///< what the static tf says now
+  std::optional<AlignmentResult> accepted_result;  ///< latest result that passed the gates
+  std::string state = "waiting_for_data";
+  std::string state_message = "waiting for IMU and camera data";
+  bool recalibrating = false;
+  std::optional<StationaryPose> last_pose;
+
+  void advertise();
+  /// Gates of WrapperSettings; false with the reason.
+  bool passesGates(const AlignmentResult& result, std::string* why) const;
+  void broadcast(const Eigen::Matrix3d& R_cam_imu);
+  bool save(const AlignmentResult& result, std::string* error);
+  void loadSaved();
+  void publishStatus();
+  void publishPoses();
+  std::string cameraFrame() const;
+  std::string imuFrame() const;
+  bool onCalibrate(Calibrate::Request& req, Calibrate::Response& res);
+  bool onReset(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  bool onSave(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  bool onCapturePose(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+};
+
+}  // namespace camera_imu_alignment

@@ -1,0 +1,189 @@
+// rostest of the nodelet and of alignment_node (one source, two .test files): simulated bags are
+// played with --clock under use_sim_time; the static tf, the services, a remount and a restart
+// from the saved file are checked against the simulator's truth. Waits poll with wall-clock
+// deadlines (the sim clock stops with the bag); no fixed sleeps decide anything.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <std_srvs/Trigger.h>
+#include <tf2_ros/transform_listener.h>
+
+#include <Eigen/Geometry>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <future>
+#include <optional>
+
+#include "camera_imu_alignment/AlignmentStatus.h"
+#include "camera_imu_alignment/Calibrate.h"
+#include "camera_imu_alignment/result_yaml.h"
+#include "camera_imu_alignment/rotation_math.h"
+#include "test_helpers.h"
+#include "tool_runner.h"
+
+namespace camera_imu_alignment {
+namespace {
+
+const std::string kNode = "/camera_imu_alignment";
+
+std::string temp(const std::string& name) { return test::processTempDir() + name; }
+
+/// Simulates a bag (5 Hz camera) and checks that its target is the one the node was started with.
+std::string simulate(const std::string& name, const std::string& options) {
+  const std::string bag = temp(name + ".bag");
+  const test::ToolRun r = test::runTool(std::string(SIMULATE_BAG_EXE) + " --out " + bag +
+                                        " --camera-rate-hz 5 " + options);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  const std::string stem = bag.substr(0, bag.size() - 4);
+  EXPECT_EQ(test::readTextFile(stem + ".target.yaml"), test::readTextFile(TARGET_YAML))
+      << "the simulator's target changed: update test/data/sim_checkerboard_8x6.yaml";
+  return bag;
+}
+
+/// Plays a bag with --clock (blocking, in the background through std::async).
+std::future<int> play(const std::string& bag, double rate) {
+  const std::string cmd = "rosbag play --clock --quiet --delay 1 --rate " + std::to_string(rate) +
+                          " " + bag + " >/dev/null 2>&1";
+  return std::async(std::launch::async, [cmd] { return std::system(cmd.c_str()); });
+}
+
+/// R_cam_imu broadcast from `camera` to `imu` (parent camera), polled until `timeout_s` (wall).
+/// `accept` decides whether a seen value is the awaited one.
+std::optional<Eigen::Matrix3d> waitForTf(
+    tf2_ros::Buffer& buffer, const std::string& camera, const std::string& imu, double timeout_s,
+    const std::function<bool(const Eigen::Matrix3d&)>& accept = [](const auto&) { return true; }) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  std::optional<Eigen::Matrix3d> last;
+  while (std::chrono::steady_clock::now() < deadline && ros::ok()) {
+    if (buffer.canTransform(camera, imu, ros::Time(0))) {
+      const auto t = buffer.lookupTransform(camera, imu, ros::Time(0)).transform.rotation;
+      last = Eigen::Quaterniond(t.w, t.x, t.y, t.z).toRotationMatrix();
+      if (accept(*last)) return last;
+    }
+    ros::WallDuration(0.2).sleep();
+  }
+  return last;
+}
+
+double angleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  return rad2deg(rotationAngle(a.transpose() * b));
+}
+
+Eigen::Matrix3d toMatrix(const geometry_msgs::Quaternion& q) {
+  return Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized().toRotationMatrix();
+}
+
+template <typename Srv>
+bool call(const std::string& name, Srv* srv) {
+  if (!ros::service::waitForService(kNode + "/" + name, ros::Duration(30.0))) return false;
+  return ros::service::call(kNode + "/" + name, *srv);
+}
+
+/// The latest ~status, polled until `pred` holds or `timeout_s` (wall) passes.
+std::optional<AlignmentStatus> waitForStatus(
+    double timeout_s, const std::function<bool(const AlignmentStatus&)>& pred) {
+  ros::NodeHandle nh;
+  std::optional<AlignmentStatus> last;
+  auto sub = nh.subscribe<AlignmentStatus>(kNode + "/status", 10,
+                                           [&](const AlignmentStatus::ConstPtr& m) { last = *m; });
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (std::chrono::steady_clock::now() < deadline && ros::ok()) {
+    if (last && pred(*last)) return last;
+    ros::WallDuration(0.1).sleep();
+  }
+  return last;
+}
+
+class AlignmentRos : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    static ros::AsyncSpinner spinner(2);  // after ros::init (main)
+    spinner.start();
+  }
+  tf2_ros::Buffer buffer_;
+  tf2_ros::TransformListener listener_{buffer_};
+};
+
+TEST_F(AlignmentRos, ReplayBroadcastsTheTruthAndTheServicesWork) {
+  const std::string bag = simulate("nominal", "--scenario nominal --seed 41 --num-poses 7");
+  const Eigen::Matrix3d R_true =
+      readResultYaml(bag.substr(0, bag.size() - 4) + ".truth.yaml").R_cam_imu;
+  auto player = play(bag, 3.0);
+  const auto R = waitForTf(buffer_, "camera_optical_frame", "imu_link", 180.0);
+  ASSERT_TRUE(R) << "no tf camera_optical_frame -> imu_link";
+  EXPECT_LT(angleDeg(*R, R_true), 0.2);
+  EXPECT_EQ(player.get(), 0);
+
+  const auto status = waitForStatus(10.0, [](const AlignmentStatus& s) { return s.has_estimate; });
+  ASSERT_TRUE(status);
+  EXPECT_EQ(status->state, AlignmentStatus::CALIBRATED) << status->message;
+  EXPECT_GE(status->poses_in_window, 3u);
+  EXPECT_TRUE(status->broadcast);
+
+  Calibrate calibrate;
+  ASSERT_TRUE(call("calibrate", &calibrate));
+  EXPECT_TRUE(calibrate.response.success) << calibrate.response.message;
+  EXPECT_TRUE(calibrate.response.observable);
+  EXPECT_LT(angleDeg(toMatrix(calibrate.response.q_cam_imu), R_true), 0.2);
+  EXPECT_GT(calibrate.response.std_dev_deg[0], 0.0);
+
+  std_srvs::Trigger save;
+  ASSERT_TRUE(call("save", &save));
+  ASSERT_TRUE(save.response.success) << save.response.message;
+  std::string output;
+  ASSERT_TRUE(ros::param::get(kNode + "/output_file", output));
+  EXPECT_LT(angleDeg(readResultYaml(output).R_cam_imu, R_true), 0.2);
+  const std::string saved = temp("saved.yaml");
+  std::filesystem::copy_file(output, saved, std::filesystem::copy_options::overwrite_existing);
+
+  std_srvs::Trigger capture;
+  ASSERT_TRUE(call("capture_pose", &capture));
+  EXPECT_FALSE(capture.response.success);  // automatic mode
+  EXPECT_NE(capture.response.message.find("manual_capture"), std::string::npos);
+
+  std_srvs::Trigger reset;
+  ASSERT_TRUE(call("reset", &reset));
+  EXPECT_TRUE(reset.response.success);
+  Calibrate after_reset;
+  ASSERT_TRUE(call("calibrate", &after_reset));
+  EXPECT_FALSE(after_reset.response.success);
+  EXPECT_EQ(after_reset.response.poses, 0u);
+
+  // A restarted node (another name and frames) broadcasts the saved calibration at once.
+  const std::string restart =
+      std::string(ALIGNMENT_NODE_EXE) + " __name:=restarted _target_file:=" + TARGET_YAML +
+      " _output_file:=" + saved + " _camera_frame:=restored_cam _imu_frame:=restored_imu" + " >" +
+      temp("restarted.log") + " 2>&1 & echo $! >" + temp("restarted.pid");
+  ASSERT_EQ(std::system(restart.c_str()), 0);
+  const auto restored = waitForTf(buffer_, "restored_cam", "restored_imu", 30.0);
+  std::system(("kill $(cat " + temp("restarted.pid") + ")").c_str());
+  ASSERT_TRUE(restored) << test::readTextFile(temp("restarted.log"));
+  EXPECT_LT(angleDeg(*restored, R_true), 0.2);
+}
+
+TEST_F(AlignmentRos, RemountReconvergesToTheNewMounting) {
+  // The mount turns by 10 deg about the camera y axis halfway: the window restarts from the poses
+  // that disagree and the tf follows.
+  std_srvs::Trigger reset;
+  ASSERT_TRUE(call("reset", &reset));
+  const std::string bag = simulate("remount", "--scenario remount --seed 43");
+  const std::string stem = bag.substr(0, bag.size() - 4);
+  const Eigen::Matrix3d R_after = readResultYaml(stem + ".truth.yaml").R_cam_imu;
+  auto player = play(bag, 3.0);
+  const auto R = waitForTf(buffer_, "camera_optical_frame", "imu_link", 240.0,
+                           [&](const Eigen::Matrix3d& r) { return angleDeg(r, R_after) < 0.3; });
+  EXPECT_EQ(player.get(), 0);
+  ASSERT_TRUE(R);
+  EXPECT_LT(angleDeg(*R, R_after), 0.3);
+}
+
+}  // namespace
+}  // namespace camera_imu_alignment
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "alignment_test");
+  ros::NodeHandle nh;  // keeps the node up for the whole run
+  return RUN_ALL_TESTS();
+}
