@@ -115,8 +115,11 @@ TEST_F(AlignmentRos, ReplayBroadcastsTheTruthAndTheServicesWork) {
   EXPECT_LT(angleDeg(*R, R_true), 0.2);
   EXPECT_EQ(player.get(), 0);
 
-  const auto status = waitForStatus(10.0, [](const AlignmentStatus& s) { return s.has_estimate; });
+  // The last rest is closed 2 s (wall) after the IMU stops: then all 7 poses are in.
+  const auto status = waitForStatus(
+      30.0, [](const AlignmentStatus& s) { return s.has_estimate && s.poses_total == 7u; });
   ASSERT_TRUE(status);
+  EXPECT_EQ(status->poses_total, 7u);
   EXPECT_EQ(status->state, AlignmentStatus::CALIBRATED) << status->message;
   EXPECT_GE(status->poses_in_window, 3u);
   EXPECT_TRUE(status->broadcast);
@@ -127,6 +130,14 @@ TEST_F(AlignmentRos, ReplayBroadcastsTheTruthAndTheServicesWork) {
   EXPECT_TRUE(calibrate.response.observable);
   EXPECT_LT(angleDeg(toMatrix(calibrate.response.q_cam_imu), R_true), 0.2);
   EXPECT_GT(calibrate.response.std_dev_deg[0], 0.0);
+  // calibrate_bag drives the same pipeline: the same poses, the same answer.
+  const std::string offline = temp("offline.yaml");
+  const test::ToolRun tool =
+      test::runTool(std::string(CALIBRATE_BAG_EXE) + " --quiet --bag " + bag + " --target " +
+                    TARGET_YAML + " --output " + offline);
+  ASSERT_EQ(tool.exit_code, 0) << tool.err;
+  EXPECT_LT(angleDeg(readResultYaml(offline).R_cam_imu, toMatrix(calibrate.response.q_cam_imu)),
+            0.01);
 
   std_srvs::Trigger save;
   ASSERT_TRUE(call("save", &save));

@@ -35,6 +35,7 @@ AlignmentWrapper::Impl::Impl(ros::NodeHandle nh_, ros::NodeHandle private_nh)
   mag_sub = nh.subscribe("imu/mag", 2000, &Impl::onMag, this);
   camera_sub = transport.subscribeCamera("camera/image_raw", 30, &Impl::onImage, this,
                                          image_transport::TransportHints(settings.image_transport));
+  stale_timer = nh.createWallTimer(ros::WallDuration(0.5), [this](const auto&) { checkStale(); });
   ROS_INFO_STREAM("camera_imu_alignment: listening on "
                   << imu_sub.getTopic() << ", " << mag_sub.getTopic() << ", "
                   << camera_sub.getTopic() << " (+ " << camera_sub.getInfoTopic() << ")");
@@ -66,9 +67,20 @@ void AlignmentWrapper::Impl::applyPendingReset() {
   pipeline->reset();
 }
 
+void AlignmentWrapper::Impl::checkStale() {
+  if (input_stopped || (ros::WallTime::now() - last_imu_wall).toSec() < 2.0) return;
+  input_stopped = true;
+  ROS_INFO("camera_imu_alignment: no IMU data for 2 s: closing the rest in progress");
+  pipeline->finish();
+  applyPendingReset();
+  publishStatus();
+}
+
 void AlignmentWrapper::Impl::onImu(const sensor_msgs::ImuConstPtr& msg) {
   if (!acceptStamp(msg->header.stamp, "imu")) return;
   imu_msg_frame = msg->header.frame_id;
+  last_imu_wall = ros::WallTime::now();
+  input_stopped = false;
   pipeline->addImu(toImuSample(*msg));
   applyPendingReset();
 }

@@ -39,6 +39,12 @@ struct AlignmentWrapper::Impl {
   double last_stamp_s = -1.0;              ///< newest input stamp (clock jumps)
   bool reset_requested = false;            ///< applied after the pipeline call returns
   bool capture_armed = false;              ///< manual_capture: ~capture_pose called for this rest
+  ros::WallTime last_imu_wall;             ///< receipt time of the newest IMU message
+  bool input_stopped = true;               ///< no IMU for a while: the rest in progress was closed
+  ros::WallTimer stale_timer;
+  /// IMU silent for 2 s of wall time (a bag ended, a driver stopped): close the rest in progress
+  /// so that the last pose counts.
+  void checkStale();
   void onImu(const sensor_msgs::ImuConstPtr& msg);
   void onMag(const sensor_msgs::MagneticFieldConstPtr& msg);
   void onImage(const sensor_msgs::ImageConstPtr& image,
