@@ -69,6 +69,8 @@ struct OptimalResult {
   std::vector<bool> inlier;                ///< per input pair
   std::vector<std::string> rejection;      ///< per input pair, "" for inliers
   std::vector<Eigen::Vector3d> residuals;  ///< per input pair at R_cam_imu (rad, camera frame)
+  /// Per input pair: rotation angles (rad) of A_j (x) and B_j (y), as rotationAngle gives them.
+  std::vector<Eigen::Vector2d> pair_angles_rad;
 };
 
 /// Estimates R_cam_imu from the pairs (which must be rotation matrices).

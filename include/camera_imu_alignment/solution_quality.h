@@ -70,12 +70,15 @@ void pairAnglesDeg(const RotationPair& pair, double* angle_cam_deg, double* angl
 
 /// Evaluates residuals, covariance and observability of R_cam_imu on the pairs; `inlier` marks the
 /// pairs used (all when empty); `rejection` gives reasons for the others (may be empty);
-/// `residuals`, when it has one entry per pair, holds r_j at R_cam_imu already (not recomputed).
+/// `residuals`, when it has one entry per pair, holds r_j at R_cam_imu already (not recomputed);
+/// `angles_rad`, when it has one entry per pair, holds the rotation angles (rad) of A_j and B_j
+/// (as rotationAngle computes them; not recomputed).
 SolutionQuality evaluateQuality(const RotationPairs& pairs, const Eigen::Matrix3d& R_cam_imu,
                                 const std::vector<bool>& inlier = {},
                                 const std::vector<std::string>& rejection = {},
                                 const QualityOptions& options = {},
-                                const std::vector<Eigen::Vector3d>& residuals = {});
+                                const std::vector<Eigen::Vector3d>& residuals = {},
+                                const std::vector<Eigen::Vector2d>& angles_rad = {});
 
 /// Name of the camera axis closest to `axis` ("x", "y" or "z").
 std::string axisName(const Eigen::Vector3d& axis);

@@ -40,6 +40,7 @@ AlignmentResult solveAlignment(const RotationPairs& pairs, const SolverOptions& 
   std::vector<bool> inlier;
   std::vector<std::string> rejection;
   std::vector<Eigen::Vector3d> residuals;
+  std::vector<Eigen::Vector2d> angles_rad;
   if (options.method == SolverMethod::kTwoStep) {
     result.two_step = solveTwoStep(pairs, options.two_step);
     result.R_cam_imu = result.two_step.R_cam_imu_left;
@@ -57,6 +58,7 @@ AlignmentResult solveAlignment(const RotationPairs& pairs, const SolverOptions& 
     inlier = std::move(opt.inlier);
     rejection = std::move(opt.rejection);
     residuals = std::move(opt.residuals);
+    angles_rad = std::move(opt.pair_angles_rad);
   }
   if (!result.R_cam_imu.allFinite()) {
     result.R_cam_imu.setIdentity();
@@ -65,7 +67,8 @@ AlignmentResult solveAlignment(const RotationPairs& pairs, const SolverOptions& 
     return result;
   }
   result.quality =
-      evaluateQuality(pairs, result.R_cam_imu, inlier, rejection, options.quality, residuals);
+      evaluateQuality(pairs, result.R_cam_imu, inlier, rejection, options.quality, residuals,
+                      angles_rad);
   result.status = result.quality.observable ? SolveStatus::kOk : SolveStatus::kNotObservable;
   if (options.method == SolverMethod::kTwoStep) {
     // The two-step can converge to a wrong fixed point (mountings far from its initial value) or

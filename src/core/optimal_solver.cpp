@@ -29,9 +29,10 @@ double robustLoss(double r2, double cauchy_scale) {
   return c2 * std::log1p(r2 / c2);
 }
 
-/// Each pair's A and B^-1 as unit quaternions, computed once per solve: a residual is then
-/// Log(q_A q_X q_B^-1 q_X^-1), three Hamilton products instead of three 3x3 products and a matrix
-/// logarithm (the same value as pairResidual).
+/// Each pair's A and B^-1 as unit quaternions, computed once per solve. A residual is
+/// Log(q_A q_X q_B^-1 q_X^-1) (the same value as pairResidual), and q_X q_B^-1 q_X^-1 is q_B^-1
+/// with its vector part rotated by X: one 3x3 product and one Hamilton product instead of three
+/// 3x3 products and a matrix logarithm.
 class PairQuaternions {
  public:
   explicit PairQuaternions(const RotationPairs& pairs) {
@@ -42,8 +43,13 @@ class PairQuaternions {
       b_inv_.push_back(Eigen::Quaterniond(p.B_imu).normalized().conjugate());
     }
   }
-  Eigen::Vector3d residual(int j, const Eigen::Quaterniond& x) const {
-    return logQuaternion(a_[j] * x * b_inv_[j] * x.conjugate());
+  /// r_j at the rotation matrix X.
+  Eigen::Vector3d residual(int j, const Eigen::Matrix3d& X) const {
+    const Eigen::Quaterniond& b = b_inv_[j];
+    Eigen::Quaterniond x_b_x;  // q_X q_B^-1 q_X^-1
+    x_b_x.w() = b.w();
+    x_b_x.vec().noalias() = X * b.vec();
+    return logQuaternion(a_[j] * x_b_x);
   }
 
  private:
@@ -54,11 +60,10 @@ class PairQuaternions {
 double evaluateResiduals(const PairQuaternions& quats, const std::vector<int>& idx,
                          const Eigen::Matrix3d& X, double cauchy_scale,
                          std::vector<Eigen::Vector3d>* residuals) {
-  const Eigen::Quaterniond x(X);
   residuals->resize(idx.size());
   double cost = 0.0;
   for (size_t i = 0; i < idx.size(); ++i) {
-    (*residuals)[i] = quats.residual(idx[i], x);
+    (*residuals)[i] = quats.residual(idx[i], X);
     cost += robustLoss((*residuals)[i].squaredNorm(), cauchy_scale);
   }
   return cost;
@@ -74,10 +79,9 @@ std::vector<double> normsOf(const std::vector<Eigen::Vector3d>& residuals, size_
 
 std::vector<double> residualNorms(const PairQuaternions& quats, const std::vector<int>& idx,
                                   const Eigen::Matrix3d& X) {
-  const Eigen::Quaterniond x(X);
   std::vector<double> r;
   r.reserve(idx.size());
-  for (int j : idx) r.push_back(quats.residual(j, x).norm());
+  for (int j : idx) r.push_back(quats.residual(j, X).norm());
   return r;
 }
 
@@ -191,12 +195,16 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
   result.rejection.assign(n, "");
   if (n == 0) return result;
 
-  // 1. Angle gate.
+  // 1. Angle gate. The angles are kept for the quality diagnostics.
   std::vector<double> angle_diff(n);
+  result.pair_angles_rad.resize(n);
   for (int j = 0; j < n; ++j) {
-    angle_diff[j] = std::abs(rotationAngle(pairs[j].A_cam) - rotationAngle(pairs[j].B_imu));
+    Eigen::Vector2d& angles = result.pair_angles_rad[j];
+    angles << rotationAngle(pairs[j].A_cam), rotationAngle(pairs[j].B_imu);
+    angle_diff[j] = std::abs(angles.x() - angles.y());
   }
   std::vector<int> gated;
+  gated.reserve(n);
   const double gate =
       std::max(deg2rad(o.angle_gate_min_deg), o.angle_gate_sigmas * 1.4826 * median(angle_diff));
   for (int j = 0; j < n; ++j) {
@@ -224,6 +232,7 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
   std::vector<double> start_norms = normsOf(start_residuals, gated.size());
   const double start_median = median(start_norms);
   std::vector<double> gated_angle_diff;
+  gated_angle_diff.reserve(gated.size());
   for (int j : gated) gated_angle_diff.push_back(angle_diff[j]);
   const double noise_proxy = median(gated_angle_diff);
   if (!result.two_step.converged || gated.size() <= 4 ||
@@ -254,6 +263,7 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
     // Pairs of `gated` whose residual norm (same order) is within the threshold.
     const auto select = [&gated](const std::vector<double>& norms, double threshold) {
       std::vector<int> in;
+      in.reserve(gated.size());
       for (size_t i = 0; i < gated.size(); ++i) {
         if (norms[i] <= threshold) in.push_back(gated[i]);
       }

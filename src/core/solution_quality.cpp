@@ -35,11 +35,29 @@ Eigen::Vector3d pairResidual(const RotationPair& pair, const Eigen::Matrix3d& R_
 }
 
 Eigen::Matrix3d pairJacobian(const RotationPair& pair, const Eigen::Vector3d& residual) {
-  // Jl^-1(r) = I - Phi/2 + c Phi^2 and Jr^-1(r) = Jl^-1(-r) = I + Phi/2 + c Phi^2 share Phi^2.
-  const Eigen::Matrix3d Phi = skew(residual);
-  const Eigen::Matrix3d common =
-      Eigen::Matrix3d::Identity() + jacobianInverseCoefficient(residual.norm()) * Phi * Phi;
-  return (common - 0.5 * Phi) * pair.A_cam - (common + 0.5 * Phi);
+  // Jl^-1(r) = I - Phi/2 + c Phi^2 and Jr^-1(r) = Jl^-1(-r) = I + Phi/2 + c Phi^2 share
+  // common = I + c Phi^2, with Phi^2 = r r^T - |r|^2 I (Phi = skew(r)); written out entry-wise.
+  const double x = residual.x(), y = residual.y(), z = residual.z();
+  const double angle2 = x * x + y * y + z * z;
+  // c(theta): its small-angle series needs only theta^2 (no square root).
+  const double c = angle2 < 0.01 ? 1.0 / 12.0 + angle2 * (1.0 / 720.0 +
+                                                          angle2 * (1.0 / 30240.0 +
+                                                                    angle2 / 1209600.0))
+                                 : jacobianInverseCoefficient(std::sqrt(angle2));
+  const double cxy = c * x * y, cxz = c * x * z, cyz = c * y * z;
+  const double hx = 0.5 * x, hy = 0.5 * y, hz = 0.5 * z;
+  Eigen::Matrix3d common;
+  common << 1.0 - c * (y * y + z * z), cxy, cxz,  //
+      cxy, 1.0 - c * (x * x + z * z), cyz,        //
+      cxz, cyz, 1.0 - c * (x * x + y * y);
+  Eigen::Matrix3d half_phi;
+  half_phi << 0.0, -hz, hy,  //
+      hz, 0.0, -hx,          //
+      -hy, hx, 0.0;
+  Eigen::Matrix3d J;
+  J.noalias() = (common - half_phi).lazyProduct(pair.A_cam);
+  J -= common + half_phi;
+  return J;
 }
 
 void pairAnglesDeg(const RotationPair& pair, double* angle_cam_deg, double* angle_imu_deg) {
@@ -57,11 +75,14 @@ SolutionQuality evaluateQuality(const RotationPairs& pairs, const Eigen::Matrix3
                                 const std::vector<bool>& inlier,
                                 const std::vector<std::string>& rejection,
                                 const QualityOptions& options,
-                                const std::vector<Eigen::Vector3d>& given_residuals) {
+                                const std::vector<Eigen::Vector3d>& given_residuals,
+                                const std::vector<Eigen::Vector2d>& given_angles_rad) {
   SolutionQuality q;
   q.num_pairs = static_cast<int>(pairs.size());
   q.pairs.resize(pairs.size());
   std::vector<int> used;
+  used.reserve(pairs.size());
+  const bool have_angles = given_angles_rad.size() == pairs.size();
   std::vector<Eigen::Vector3d> residuals(pairs.size());
   std::vector<Eigen::Matrix3d> jacobians(pairs.size());
   Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
@@ -71,7 +92,12 @@ SolutionQuality evaluateQuality(const RotationPairs& pairs, const Eigen::Matrix3
     residuals[j] = given_residuals.size() == pairs.size() ? given_residuals[j]
                                                           : pairResidual(pairs[j], R_cam_imu);
     d.residual_deg = rad2deg(residuals[j].norm());
-    pairAnglesDeg(pairs[j], &d.angle_cam_deg, &d.angle_imu_deg);
+    if (have_angles) {
+      d.angle_cam_deg = rad2deg(given_angles_rad[j].x());
+      d.angle_imu_deg = rad2deg(given_angles_rad[j].y());
+    } else {
+      pairAnglesDeg(pairs[j], &d.angle_cam_deg, &d.angle_imu_deg);
+    }
     d.inlier = inlier.empty() || inlier[j];
     if (!d.inlier && j < rejection.size()) d.rejection = rejection[j];
     if (!d.inlier) continue;
@@ -165,7 +191,8 @@ SolutionQuality evaluateQuality(const RotationPairs& pairs, const Eigen::Matrix3
   } else {
     q.observable = true;
     // The numbers are in the fields; solveAlignment's message repeats the ones that matter.
-    std::snprintf(msg, sizeof(msg), "observable");
+    q.observability_message = "observable";
+    return q;
   }
   q.observability_message = msg;
   return q;
