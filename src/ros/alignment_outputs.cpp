@@ -1,10 +1,13 @@
 // AlignmentWrapper, output side: quality gates, the static tf, ~status, ~stationary_poses, the
 // saved calibration, services and diagnostics.
 #include <geometry_msgs/PoseArray.h>
+#include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <filesystem>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 
 #include "alignment_wrapper_impl.h"
@@ -37,6 +40,8 @@ std::string fixed(double value, int precision) {
 void AlignmentWrapper::Impl::advertise() {
   status_pub = pnh.advertise<AlignmentStatus>("status", 10, true);
   poses_pub = pnh.advertise<geometry_msgs::PoseArray>("stationary_poses", 1, true);
+  target_pose_pub = pnh.advertise<geometry_msgs::PoseStamped>("target_pose", 1, true);
+  debug_pub = image_transport::ImageTransport(pnh).advertise("debug_image", 1);
   calibrate_srv = pnh.advertiseService("calibrate", &Impl::onCalibrate, this);
   reset_srv = pnh.advertiseService("reset", &Impl::onReset, this);
   save_srv = pnh.advertiseService("save", &Impl::onSave, this);
@@ -205,6 +210,56 @@ void AlignmentWrapper::Impl::publishPoses() {
     out.poses.push_back(pose);
   }
   poses_pub.publish(out);
+  if (pipeline->poses().empty()) return;
+  // The target seen from the camera at the last pose: R_cam_target = R_target_cam^T.
+  const StationaryPose& last = pipeline->poses().back();
+  geometry_msgs::PoseStamped target;
+  target.header.stamp = ros::Time(last.end_s);
+  target.header.frame_id = cameraFrame();
+  const Eigen::Vector3d p_cam_target = -(last.R_target_cam.transpose() * last.p_target_cam);
+  target.pose.position.x = p_cam_target.x();
+  target.pose.position.y = p_cam_target.y();
+  target.pose.position.z = p_cam_target.z();
+  target.pose.orientation = toMsg(last.R_target_cam.transpose());
+  target_pose_pub.publish(target);
+  // The same as a tf frame, so that rviz can show camera, IMU and target together.
+  geometry_msgs::TransformStamped t;
+  t.header = target.header;
+  t.child_frame_id = "calibration_target";
+  t.transform.translation.x = p_cam_target.x();
+  t.transform.translation.y = p_cam_target.y();
+  t.transform.translation.z = p_cam_target.z();
+  t.transform.rotation = target.pose.orientation;
+  target_broadcaster.sendTransform(t);
+}
+
+void AlignmentWrapper::Impl::publishDebugImage(const cv::Mat& mono8,
+                                               const std_msgs::Header& header) {
+  if (debug_pub.getNumSubscribers() == 0) return;
+  const ros::WallTime now = ros::WallTime::now();
+  if ((now - last_debug).toSec() < 0.2) return;
+  last_debug = now;
+  TargetObservation observation;
+  const bool found = debug_detector->detect(mono8, &observation);
+  cv::Mat bgr;
+  cv::cvtColor(mono8, bgr, cv::COLOR_GRAY2BGR);
+  for (std::size_t i = 0; i < observation.image_points.size(); ++i) {
+    const cv::Scalar colour = observation.point_ids[i] == 0 ? cv::Scalar(0, 0, 255)  // origin red
+                                                            : cv::Scalar(0, 255, 0);
+    cv::circle(bgr, observation.image_points[i], 3, colour, 1, cv::LINE_AA);
+  }
+  const std::string text =
+      found ? std::to_string(observation.image_points.size()) + " points" : "target not found";
+  cv::putText(bgr, text, cv::Point(10, 25), cv::FONT_HERSHEY_SIMPLEX, 0.7,
+              found ? cv::Scalar(0, 255, 0) : cv::Scalar(0, 0, 255), 2, cv::LINE_AA);
+  sensor_msgs::Image out;
+  out.header = header;
+  out.height = static_cast<std::uint32_t>(bgr.rows);
+  out.width = static_cast<std::uint32_t>(bgr.cols);
+  out.encoding = "bgr8";
+  out.step = static_cast<std::uint32_t>(bgr.cols * 3);
+  out.data.assign(bgr.data, bgr.data + bgr.total() * 3);
+  debug_pub.publish(out);
 }
 
 bool AlignmentWrapper::Impl::onCalibrate(Calibrate::Request&, Calibrate::Response& res) {
@@ -280,6 +335,12 @@ void AlignmentWrapper::Impl::diagnose(diagnostic_updater::DiagnosticStatusWrappe
                               : state == "recalibrating"  ? DiagnosticStatus::WARN
                                                           : DiagnosticStatus::OK;
   status.summary(level, state + ": " + state_message);
+  const double elapsed = std::max(1e-3, (ros::WallTime::now() - last_diagnostics).toSec());
+  last_diagnostics = ros::WallTime::now();
+  status.add("imu rate (Hz)", imu_count / elapsed);
+  status.add("magnetometer rate (Hz)", mag_count / elapsed);
+  status.add("image rate (Hz)", image_count / elapsed);
+  imu_count = mag_count = image_count = 0;
   status.add("imu samples", pipeline->imuSamples());
   status.add("magnetometer samples", pipeline->magneticSamples());
   status.add("frames", pipeline->frames());

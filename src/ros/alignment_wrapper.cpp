@@ -26,6 +26,7 @@ AlignmentWrapper::Impl::Impl(ros::NodeHandle nh_, ros::NodeHandle private_nh)
   callbacks.on_result = [this](const AlignmentResult& r) { onResult(r); };
   callbacks.on_reject = [this](RejectReason reason, const std::string& d) { onReject(reason, d); };
   pipeline = std::make_unique<CalibrationPipeline>(target, pipeline_settings, callbacks);
+  debug_detector = std::make_unique<TargetDetector>(target, pipeline_settings.detector);
   ROS_INFO_STREAM("camera_imu_alignment: target " << target.describe() << " from "
                                                   << settings.target_file);
 
@@ -81,12 +82,14 @@ void AlignmentWrapper::Impl::onImu(const sensor_msgs::ImuConstPtr& msg) {
   imu_msg_frame = msg->header.frame_id;
   last_imu_wall = ros::WallTime::now();
   input_stopped = false;
+  ++imu_count;
   pipeline->addImu(toImuSample(*msg));
   applyPendingReset();
 }
 
 void AlignmentWrapper::Impl::onMag(const sensor_msgs::MagneticFieldConstPtr& msg) {
   if (!acceptStamp(msg->header.stamp, "imu/mag")) return;
+  ++mag_count;
   pipeline->addMagnetic(toMagneticSample(*msg));
   applyPendingReset();
 }
@@ -95,6 +98,7 @@ void AlignmentWrapper::Impl::onImage(const sensor_msgs::ImageConstPtr& image,
                                      const sensor_msgs::CameraInfoConstPtr& info) {
   if (!acceptStamp(image->header.stamp, "camera")) return;
   image_frame = image->header.frame_id;
+  ++image_count;
   if (info->K != last_info.K || info->D != last_info.D || info->width != last_info.width ||
       info->height != last_info.height || info->distortion_model != last_info.distortion_model) {
     CameraIntrinsics intrinsics;
@@ -106,7 +110,8 @@ void AlignmentWrapper::Impl::onImage(const sensor_msgs::ImageConstPtr& image,
     }
     if (pipeline->setCameraIntrinsics(intrinsics)) last_info = *info;
   }
-  if (settings.manual_capture && !capture_armed) return;  // poses only when asked
+  const bool wanted = !settings.manual_capture || capture_armed;  // manual: poses only when asked
+  if (!wanted && debug_pub.getNumSubscribers() == 0) return;
   cv::Mat mono8;
   std::string error;
   if (!toMono8(*image, &mono8, &error)) {
@@ -114,8 +119,11 @@ void AlignmentWrapper::Impl::onImage(const sensor_msgs::ImageConstPtr& image,
                       error.c_str());
     return;
   }
-  pipeline->addFrame({image->header.stamp.toSec(), mono8});
-  applyPendingReset();
+  if (wanted) {
+    pipeline->addFrame({image->header.stamp.toSec(), mono8});
+    applyPendingReset();
+  }
+  publishDebugImage(mono8, image->header);
 }
 
 void AlignmentWrapper::Impl::onPose(const StationaryPose& pose) {

@@ -11,6 +11,7 @@
 #include <sensor_msgs/MagneticField.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/static_transform_broadcaster.h>
+#include <tf2_ros/transform_broadcaster.h>
 
 #include <memory>
 #include <optional>
@@ -19,6 +20,7 @@
 #include "camera_imu_alignment/calibration_pipeline.h"
 #include "camera_imu_alignment/ros/alignment_wrapper.h"
 #include "camera_imu_alignment/ros/wrapper_settings.h"
+#include "camera_imu_alignment/target_detector.h"
 
 namespace camera_imu_alignment {
 
@@ -63,7 +65,17 @@ struct AlignmentWrapper::Impl {
 
   // --- outputs (alignment_outputs.cpp)
   tf2_ros::StaticTransformBroadcaster broadcaster;
-  ros::Publisher status_pub, poses_pub;
+  tf2_ros::TransformBroadcaster target_broadcaster;  ///< camera -> calibration_target (rviz)
+  ros::Publisher status_pub, poses_pub, target_pose_pub;
+  image_transport::Publisher debug_pub;
+  std::unique_ptr<TargetDetector> debug_detector;  ///< for ~debug_image only
+  ros::WallTime last_debug;
+  /// Draws the detected target points on `mono8` and publishes it, at most 5 per second and only
+  /// while someone subscribes to ~debug_image.
+  void publishDebugImage(const cv::Mat& mono8, const std_msgs::Header& header);
+  // Input counts since the last diagnostics update (rates).
+  std::uint64_t imu_count = 0, mag_count = 0, image_count = 0;
+  ros::WallTime last_diagnostics = ros::WallTime::now();
   ros::ServiceServer calibrate_srv, reset_srv, save_srv, capture_srv;
   ros::Timer status_timer;
   diagnostic_updater::Updater diagnostics;
@@ -82,7 +94,7 @@ struct AlignmentWrapper::Impl {
   bool save(const AlignmentResult& result, std::string* error);
   void loadSaved();
   void publishStatus();
-  void publishPoses();
+  void publishPoses();  ///< ~stationary_poses and ~target_pose
   std::string cameraFrame() const;
   std::string imuFrame() const;
   bool onCalibrate(Calibrate::Request& req, Calibrate::Response& res);
