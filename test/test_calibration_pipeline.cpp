@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <random>
 
 #include "camera_imu_alignment/rotation_math.h"
 #include "pipeline_simulation.h"
@@ -86,6 +88,94 @@ TEST(CalibrationPipeline, NominalRunFindsEveryPoseAndTheMounting) {
   EXPECT_EQ(r.pipeline->rejections().total(), 0u) << r.pipeline->rejections().summary();
   // A result after every pose from the third on.
   EXPECT_EQ(r.results.size(), poses.size() - 2);
+}
+
+/// A run fed without images: camera orientations given (the truth with 0.02 deg of noise per frame,
+/// at 15 Hz), as through the nodelet's camera_pose topic; optionally the IMU's own orientation
+/// (the truth with 0.05 deg of noise) in every sample.
+std::unique_ptr<CalibrationPipeline> runWithoutImages(const sim::SimulationRun& run,
+                                                      const PipelineSettings& settings,
+                                                      bool imu_orientation) {
+  const Eigen::Matrix3d R_world_target = run.trajectory.R_world_target();
+  auto pipeline = std::make_unique<CalibrationPipeline>(
+      parseTargetYaml(sim::targetYaml(run.config.target), "target"), settings);
+  std::mt19937 rng(19);
+  std::normal_distribution<double> noise(0.0, deg2rad(0.02));
+  auto jitter = [&](double scale) {
+    return expSO3(scale * Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
+  };
+  std::size_t next_imu = 0, next_mag = 0;
+  auto feedUpTo = [&](double t) {
+    while (next_imu < run.imu.size() && run.imu[next_imu].t <= t) {
+      const auto& s = run.imu[next_imu++];
+      ImuSample sample{s.t, s.gyro, s.accel};
+      if (imu_orientation) {
+        sample.q_world_imu = Eigen::Quaterniond(run.trajectory.at(s.t).R_world_imu() * jitter(2.5));
+      }
+      pipeline->addImu(sample);
+    }
+    while (next_mag < run.mag.size() && run.mag[next_mag].t <= t) {
+      const auto& s = run.mag[next_mag++];
+      pipeline->addMagnetic({s.t, s.field});
+    }
+  };
+  for (double t = 0.0; t < run.imu.back().t; t += 1.0 / 15.0) {
+    feedUpTo(t);
+    CameraFrame frame;
+    frame.stamp_s = t;
+    frame.R_target_cam = R_world_target.transpose() * run.trajectory.at(t).R_world_cam * jitter(1);
+    pipeline->addFrame(frame);
+  }
+  feedUpTo(std::numeric_limits<double>::infinity());
+  pipeline->finish();
+  return pipeline;
+}
+
+std::unique_ptr<sim::SimulationRun> runOf(const std::string& name, std::uint64_t seed) {
+  sim::SimulationConfig c = scenario(name, seed);
+  c.camera_rate_hz = 1.0;  // nothing is rendered here; frame times are chosen by the test
+  return std::make_unique<sim::SimulationRun>(c);
+}
+
+TEST(CalibrationPipeline, GivenCameraOrientationsNeedNoImages) {
+  const auto simulated = runOf("nominal", 19);
+  const sim::SimulationRun& run = *simulated;
+  const auto pipeline = runWithoutImages(run, PipelineSettings(), false);
+  EXPECT_EQ(pipeline->poses().size(), run.trajectory.poses().size());
+  EXPECT_EQ(pipeline->rejections().total(), 0u) << pipeline->rejections().summary();
+  const AlignmentResult result = pipeline->solve();
+  ASSERT_EQ(result.status, SolveStatus::kOk) << result.message;
+  EXPECT_LT(rad2deg(test::leftError(result.R_cam_imu, run.trajectory.R_cam_imu_final()).norm()),
+            0.1);
+  // Not a rotation: refused and counted, never used.
+  CameraFrame broken;
+  broken.stamp_s = run.imu.back().t + 1.0;
+  broken.R_target_cam = 2.0 * Eigen::Matrix3d::Identity();
+  pipeline->addFrame(broken);
+  EXPECT_EQ(pipeline->rejections().total(), 1u);
+}
+
+TEST(CalibrationPipeline, ImuOwnOrientationIsUsedWhenAsked) {
+  const auto simulated = runOf("no_magnetometer", 23);
+  const sim::SimulationRun& run = *simulated;
+  PipelineSettings settings;
+  settings.imu_orientation = ImuOrientationSource::kMessage;
+  const auto pipeline = runWithoutImages(run, settings, true);
+  ASSERT_EQ(pipeline->poses().size(), run.trajectory.poses().size());
+  for (const auto& pose : pipeline->poses()) {
+    EXPECT_EQ(pose.imu_source, "message");
+    EXPECT_EQ(pose.group, 0);
+    const double t = 0.5 * (pose.start_s + pose.end_s);
+    EXPECT_LT(test::angleBetweenDeg(pose.R_world_imu, run.trajectory.at(t).R_world_imu()), 0.05);
+  }
+  const AlignmentResult result = pipeline->solve();
+  ASSERT_EQ(result.status, SolveStatus::kOk) << result.message;
+  EXPECT_LT(rad2deg(test::leftError(result.R_cam_imu, run.trajectory.R_cam_imu_final()).norm()),
+            0.1);
+  // Without orientations in the samples, the rule falls back to the gyro chain.
+  const auto fallback = runWithoutImages(run, settings, false);
+  ASSERT_GE(fallback->poses().size(), 2u);
+  EXPECT_EQ(fallback->poses()[1].imu_source, "gyro");
 }
 
 TEST(CalibrationPipeline, CameraTimeOffsetsOfTensOfMillisecondsChangeNothing) {

@@ -21,6 +21,9 @@
 //     compared and the difference is reported (gyro_mag_difference_deg).
 //   kMagnetometer (the paper's): accelerometer + magnetometer at every pose where the field is
 //     usable, the gyro chain otherwise.
+//   kMessage: the IMU's own orientation estimate (sensor_msgs/Imu orientation, e.g. an AHRS with
+//     an onboard filter), averaged over the rest, at every pose where at least 5 samples carry one;
+//     the gyro chain otherwise. Its world frame is the sensor's: one group.
 // Why the gyro first: over the few seconds between poses a bias-corrected MEMS gyro is accurate to
 // a few hundredths of a degree, while an accelerometer + magnetometer attitude carries the
 // accelerometer bias (tilt) and any uncalibrated iron or disturbance (heading) at every pose.
@@ -52,13 +55,18 @@
 
 namespace camera_imu_alignment {
 
-/// One camera image, already converted to mono8 by the caller (ROS wrapper / bag reader).
+/// One camera frame: an image converted to mono8 by the caller (ROS wrapper / bag reader), or a
+/// camera orientation given from elsewhere.
 struct CameraFrame {
   double stamp_s = 0.0;
-  cv::Mat mono8;  ///< CV_8UC1
+  cv::Mat mono8;  ///< CV_8UC1; unused when R_target_cam is given
+  /// The camera orientation when it comes from elsewhere (the user's own detector, motion capture:
+  /// the nodelet's camera_pose topic): then no image and no detection are needed. Use either
+  /// images or given orientations in one pipeline, not both (they share the stamp order).
+  std::optional<Eigen::Matrix3d> R_target_cam;
 };
 
-enum class ImuOrientationSource { kAuto, kMagnetometer };
+enum class ImuOrientationSource { kAuto, kMagnetometer, kMessage };
 const char* toString(ImuOrientationSource source);
 bool parseImuOrientationSource(const std::string& text, ImuOrientationSource* source);
 

@@ -7,8 +7,10 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 namespace camera_imu_alignment {
@@ -17,6 +19,9 @@ struct ImuSample {
   double stamp_s = 0.0;
   Eigen::Vector3d gyro_rad_s = Eigen::Vector3d::Zero();
   Eigen::Vector3d accel_m_s2 = Eigen::Vector3d::Zero();
+  /// The sensor's own orientation estimate (sensor_msgs/Imu orientation, q_world_imu), when it
+  /// sends one; used only with imu_orientation: message.
+  std::optional<Eigen::Quaterniond> q_world_imu;
 };
 
 struct MagneticSample {

@@ -8,11 +8,19 @@
 #include <stdexcept>
 
 #include "calibration_pipeline_impl.h"
+#include "camera_imu_alignment/rotation_math.h"
 
 namespace camera_imu_alignment {
 
 const char* toString(ImuOrientationSource source) {
-  return source == ImuOrientationSource::kMagnetometer ? "magnetometer" : "auto";
+  switch (source) {
+    case ImuOrientationSource::kMagnetometer:
+      return "magnetometer";
+    case ImuOrientationSource::kMessage:
+      return "message";
+    default:
+      return "auto";
+  }
 }
 
 bool parseImuOrientationSource(const std::string& text, ImuOrientationSource* source) {
@@ -20,6 +28,8 @@ bool parseImuOrientationSource(const std::string& text, ImuOrientationSource* so
     *source = ImuOrientationSource::kAuto;
   } else if (text == "magnetometer") {
     *source = ImuOrientationSource::kMagnetometer;
+  } else if (text == "message") {
+    *source = ImuOrientationSource::kMessage;
   } else {
     return false;
   }
@@ -151,6 +161,13 @@ void CalibrationPipeline::addImu(const ImuSample& sample) {
     s.reject(RejectReason::kZeroVector, "imu: zero accelerometer vector; sample dropped");
     return;
   }
+  if (sample.q_world_imu && !(std::abs(sample.q_world_imu->norm() - 1.0) < 1e-3)) {
+    ImuSample without = sample;  // the rates are fine: keep them, drop the orientation
+    without.q_world_imu.reset();
+    s.reject(RejectReason::kNonFinite, "imu: orientation is not a unit quaternion; ignored");
+    addImu(without);
+    return;
+  }
   if (!s.checkStamp(sample.stamp_s, &s.last_imu_stamp, "imu")) return;
   ++s.num_imu;
   // Frames are judged with the rest state before this sample: a rest that ends with this sample
@@ -208,7 +225,12 @@ void CalibrationPipeline::addFrame(const CameraFrame& frame) {
     s.reject(RejectReason::kNonFinite, "image: stamp is not finite; frame dropped");
     return;
   }
-  if (frame.mono8.empty() || frame.mono8.type() != CV_8UC1) {
+  if (frame.R_target_cam) {
+    if (!isRotationMatrix(*frame.R_target_cam, 1e-6)) {
+      s.reject(RejectReason::kNonFinite, "camera pose: not a finite unit rotation; dropped");
+      return;
+    }
+  } else if (frame.mono8.empty() || frame.mono8.type() != CV_8UC1) {
     s.reject(RejectReason::kBadImage, "image: empty or not mono8 after conversion; frame dropped");
     return;
   }
@@ -244,6 +266,13 @@ void CalibrationPipeline::Impl::processFrame(const CameraFrame& frame) {
   int in_this_rest = 0;
   for (const auto& d : detections) in_this_rest += (rest_since && d.stamp_s >= *rest_since);
   if (in_this_rest >= settings.max_frames_per_pose) return;
+  if (frame.R_target_cam) {  // given orientation: nothing to detect
+    last_detection_stamp = frame.stamp_s;
+    CameraPose given;
+    given.R_target_cam = *frame.R_target_cam;
+    detections.push_back({frame.stamp_s, given});
+    return;
+  }
   if (!intrinsics) {
     ++frames_without_intrinsics;
     return;

@@ -52,6 +52,7 @@ struct CalibrationPipeline::Impl {
   std::optional<Eigen::Matrix3d> chain_R_world_imu_accel_mag;  ///< of chain_segment
   int group = 0;
   bool group_magnetic = false;  ///< the current group's heading comes from the magnetometer
+  bool group_message = false;   ///< the current group's frame is the IMU's own (kMessage)
 
   // --- results
   std::vector<StationarySegment> segments;

@@ -48,7 +48,7 @@ const std::vector<Key>& keys() {
       {"imu_orientation",
        [](const YAML::Node& node, PipelineSettings* s) {
          if (!parseImuOrientationSource(node.as<std::string>(), &s->imu_orientation)) {
-           throw YAML::Exception(node.Mark(), "must be 'auto' or 'magnetometer'");
+           throw YAML::Exception(node.Mark(), "must be 'auto', 'magnetometer' or 'message'");
          }
        }},
       number<double>("accel_weight", [](auto* s) { return &s->accel_weight; }),

@@ -38,6 +38,25 @@ SegmentField segmentField(const std::deque<MagneticSample>& samples, double star
 
 constexpr int kMinFieldSamples = 5;
 
+/// Mean of the IMU's own orientations in [start_s, end_s] (sign-aligned quaternion average); none
+/// with fewer than 5 samples carrying one.
+std::optional<Eigen::Matrix3d> messageOrientation(const std::deque<ImuSample>& samples,
+                                                  double start_s, double end_s) {
+  Eigen::Vector4d sum = Eigen::Vector4d::Zero(), first = Eigen::Vector4d::Zero();
+  int count = 0;
+  for (const auto& s : samples) {
+    if (!s.q_world_imu || s.stamp_s < start_s || s.stamp_s > end_s) continue;
+    Eigen::Vector4d q = s.q_world_imu->coeffs();
+    if (count == 0) first = q;
+    if (q.dot(first) < 0.0) q = -q;
+    sum += q;
+    ++count;
+  }
+  if (count < 5 || !(sum.norm() > 0.0)) return std::nullopt;
+  sum.normalize();
+  return Eigen::Quaterniond(sum(3), sum(0), sum(1), sum(2)).toRotationMatrix();
+}
+
 std::string fmt(double value, int precision = 2) {
   std::ostringstream out;
   out.setf(std::ios::fixed);
@@ -136,17 +155,30 @@ void CalibrationPipeline::Impl::onSegment(const StationarySegment& segment) {
 
   // --- The orientation used (rule in calibration_pipeline.h).
   const bool prefer_mag = settings.imu_orientation == ImuOrientationSource::kMagnetometer;
-  if (pose.R_imu_previous_imu_gyro && !(prefer_mag && pose.magnetometer_usable && group_magnetic)) {
+  const std::optional<Eigen::Matrix3d> R_message =
+      settings.imu_orientation == ImuOrientationSource::kMessage
+          ? messageOrientation(imu_buffer, segment.start_s, segment.end_s)
+          : std::nullopt;
+  if (R_message) {
+    if (chain_valid && !group_message) ++group;  // the sensor's frame, unrelated to ours
+    group_message = true;
+    group_magnetic = false;
+    pose.R_world_imu = *R_message;
+    pose.imu_source = "message";
+  } else if (pose.R_imu_previous_imu_gyro &&
+             !(prefer_mag && pose.magnetometer_usable && group_magnetic)) {
     pose.R_world_imu = projectToSO3(chain_R_world_imu * *pose.R_imu_previous_imu_gyro);
     pose.imu_source = "gyro";
   } else if (pose.magnetometer_usable) {
     if (chain_valid && !group_magnetic) ++group;  // the old chain's heading was arbitrary
     group_magnetic = true;
+    group_message = false;
     pose.R_world_imu = *pose.R_world_imu_accel_mag;
     pose.imu_source = "accel_mag";
   } else {
     if (chain_valid) ++group;  // heading unknown relative to everything before
     group_magnetic = false;
+    group_message = false;
     pose.R_world_imu = attitudeFromAccel(segment.mean_accel_m_s2);
     pose.imu_source = "accel_only";
   }

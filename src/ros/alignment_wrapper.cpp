@@ -1,5 +1,6 @@
 // AlignmentWrapper, input side: settings, target, subscriptions, message conversion, the
 // pipeline and its callbacks.
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 
@@ -36,6 +37,7 @@ AlignmentWrapper::Impl::Impl(ros::NodeHandle nh_, ros::NodeHandle private_nh)
   mag_sub = nh.subscribe("imu/mag", 2000, &Impl::onMag, this);
   camera_sub = transport.subscribeCamera("camera/image_raw", 30, &Impl::onImage, this,
                                          image_transport::TransportHints(settings.image_transport));
+  camera_pose_sub = nh.subscribe("camera_pose", 100, &Impl::onCameraPose, this);
   stale_timer = nh.createWallTimer(ros::WallDuration(0.5), [this](const auto&) { checkStale(); });
   ROS_INFO_STREAM("camera_imu_alignment: listening on "
                   << imu_sub.getTopic() << ", " << mag_sub.getTopic() << ", "
@@ -124,6 +126,27 @@ void AlignmentWrapper::Impl::onImage(const sensor_msgs::ImageConstPtr& image,
     applyPendingReset();
   }
   publishDebugImage(mono8, image->header);
+}
+
+void AlignmentWrapper::Impl::onCameraPose(const geometry_msgs::PoseStampedConstPtr& msg) {
+  if (!acceptStamp(msg->header.stamp, "camera_pose")) return;
+  if (image_frame.empty()) image_frame = msg->header.frame_id;  // until an image names the camera
+  ++image_count;
+  const auto& q = msg->pose.orientation;
+  const double norm = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
+  if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-3) {
+    ROS_WARN_THROTTLE(5.0,
+                      "camera_imu_alignment: %s: orientation is not a unit quaternion "
+                      "(norm %g); pose dropped",
+                      camera_pose_sub.getTopic().c_str(), norm);
+    return;
+  }
+  if (settings.manual_capture && !capture_armed) return;
+  CameraFrame frame;
+  frame.stamp_s = msg->header.stamp.toSec();
+  frame.R_target_cam = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized().toRotationMatrix();
+  pipeline->addFrame(frame);
+  applyPendingReset();
 }
 
 void AlignmentWrapper::Impl::onPose(const StationaryPose& pose) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
+#include <geometry_msgs/PoseStamped.h>
 #include <image_transport/image_transport.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
@@ -34,7 +35,7 @@ struct AlignmentWrapper::Impl {
 
   // --- inputs
   image_transport::ImageTransport transport;
-  ros::Subscriber imu_sub, mag_sub;
+  ros::Subscriber imu_sub, mag_sub, camera_pose_sub;
   image_transport::CameraSubscriber camera_sub;
   std::string image_frame, imu_msg_frame;  ///< frame_ids seen on the inputs
   sensor_msgs::CameraInfo last_info;       ///< the intrinsics in use
@@ -51,6 +52,9 @@ struct AlignmentWrapper::Impl {
   void onMag(const sensor_msgs::MagneticFieldConstPtr& msg);
   void onImage(const sensor_msgs::ImageConstPtr& image,
                const sensor_msgs::CameraInfoConstPtr& info);
+  /// camera_pose (geometry_msgs/PoseStamped, the camera in the target frame): orientations from
+  /// the user's own detector or motion capture instead of images.
+  void onCameraPose(const geometry_msgs::PoseStampedConstPtr& msg);
   /// Stamp check shared by the inputs: a jump back by more than a second (a bag loop) resets the
   /// buffers with a warning. False when the message is to be dropped.
   bool acceptStamp(const ros::Time& stamp, const char* topic);

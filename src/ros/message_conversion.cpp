@@ -1,6 +1,7 @@
 #include "camera_imu_alignment/ros/message_conversion.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -14,6 +15,12 @@ ImuSample toImuSample(const sensor_msgs::Imu& msg) {
   sample.gyro_rad_s = {msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z};
   sample.accel_m_s2 = {msg.linear_acceleration.x, msg.linear_acceleration.y,
                        msg.linear_acceleration.z};
+  // REP-145: orientation_covariance[0] = -1 says "no orientation"; many drivers send zeros.
+  const auto& q = msg.orientation;
+  const double norm = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
+  if (msg.orientation_covariance[0] != -1.0 && norm > 0.5) {
+    sample.q_world_imu = Eigen::Quaterniond(q.w, q.x, q.y, q.z);  // the pipeline checks the norm
+  }
   return sample;
 }
 

@@ -5,7 +5,9 @@
 //
 // Topics (relative names, remap them): imu/data_raw (sensor_msgs/Imu), imu/mag
 // (sensor_msgs/MagneticField, optional), camera/image_raw + camera/camera_info (image_transport
-// CameraSubscriber; ~image_transport: compressed for CompressedImage).
+// CameraSubscriber; ~image_transport: compressed for CompressedImage); camera_pose
+// (geometry_msgs/PoseStamped, the camera in the target frame, optional: for users with their own
+// detector or motion capture, instead of images).
 #pragma once
 
 #include <ros/ros.h>

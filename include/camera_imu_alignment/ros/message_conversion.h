@@ -17,7 +17,8 @@
 
 namespace camera_imu_alignment {
 
-/// Header stamp (s), gyro (rad/s), accelerometer (m/s^2). The orientation field is ignored.
+/// Header stamp (s), gyro (rad/s), accelerometer (m/s^2), and the orientation when the message
+/// carries one (orientation_covariance[0] != -1 and a non-zero quaternion).
 ImuSample toImuSample(const sensor_msgs::Imu& msg);
 /// Header stamp (s) and field (as sent; nominally tesla).
 MagneticSample toMagneticSample(const sensor_msgs::MagneticField& msg);
