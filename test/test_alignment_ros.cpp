@@ -189,6 +189,41 @@ TEST_F(AlignmentRos, RemountReconvergesToTheNewMounting) {
   EXPECT_LT(angleDeg(*R, R_after), 0.3);
 }
 
+TEST_F(AlignmentRos, ManualCaptureTakesOnlyTheArmedRest) {
+  // A second node on its own topics with manual_capture: armed once before the bag, so the first
+  // rest becomes a pose and the later ones do not.
+  const std::string bag = simulate("manual", "--scenario nominal --seed 47 --num-poses 4");
+  const std::string node =
+      std::string(ALIGNMENT_NODE_EXE) + " __name:=manual _target_file:=" + TARGET_YAML +
+      " _manual_capture:=true _load_on_start:=false imu/data_raw:=manual/imu/data_raw" +
+      " imu/mag:=manual/imu/mag camera/image_raw:=manual/camera/image_raw" +
+      " camera/camera_info:=manual/camera/camera_info >" + temp("manual.log") +
+      " 2>&1 & echo $! >" + temp("manual.pid");
+  ASSERT_EQ(std::system(node.c_str()), 0);
+  ASSERT_TRUE(ros::service::waitForService("/manual/capture_pose", ros::Duration(30.0)));
+  std_srvs::Trigger capture;
+  ASSERT_TRUE(ros::service::call("/manual/capture_pose", capture));
+  EXPECT_TRUE(capture.response.success) << capture.response.message;
+  const std::string cmd = "rosbag play --clock --quiet --delay 1 --rate 3 " + bag +
+                          " imu/data_raw:=manual/imu/data_raw imu/mag:=manual/imu/mag" +
+                          " camera/image_raw:=manual/camera/image_raw" +
+                          " camera/camera_info:=manual/camera/camera_info >/dev/null 2>&1";
+  EXPECT_EQ(std::system(cmd.c_str()), 0);
+  // All rests but the last are judged while the bag plays (the last one, unarmed, would not count
+  // either); the status is latched.
+  ros::NodeHandle nh;
+  std::optional<AlignmentStatus> last;
+  auto sub = nh.subscribe<AlignmentStatus>("/manual/status", 10,
+                                           [&](const AlignmentStatus::ConstPtr& m) { last = *m; });
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(15);
+  while (std::chrono::steady_clock::now() < deadline && !(last && last->poses_total >= 1)) {
+    ros::WallDuration(0.1).sleep();
+  }
+  std::system(("kill $(cat " + temp("manual.pid") + ")").c_str());
+  ASSERT_TRUE(last) << test::readTextFile(temp("manual.log"));
+  EXPECT_EQ(last->poses_total, 1u) << test::readTextFile(temp("manual.log"));
+}
+
 }  // namespace
 }  // namespace camera_imu_alignment
 

@@ -26,10 +26,11 @@ struct DetectorSettings {
 };
 
 /// Detects one target type in mono8 images. Checkerboard: cv::findChessboardCorners with a fast
-/// rejection (fallback findChessboardCornersSB for blurred or oblique views) + cornerSubPix, corners re-ordered so that index 0 is always the target
-/// origin (the 180-degree ambiguity is resolved by the square colours where the board allows it,
-/// otherwise by the orientation closest to `hint`); AprilGrid: tag36h11 via OpenCV aruco, Kalibr's
-/// layout, partial views allowed; circle grid: cv::findCirclesGrid (symmetric/asymmetric).
+/// rejection (fallback findChessboardCornersSB for blurred or oblique views) + cornerSubPix,
+/// corners re-ordered so that index 0 is always the target origin (the 180-degree ambiguity is
+/// resolved by the square colours where the board allows it, otherwise by the orientation closest
+/// to `hint`); AprilGrid: tag36h11 via OpenCV aruco, Kalibr's layout, partial views allowed; circle
+/// grid: cv::findCirclesGrid (symmetric/asymmetric).
 class TargetDetector {
  public:
   explicit TargetDetector(const TargetDescription& target, const DetectorSettings& settings = {});

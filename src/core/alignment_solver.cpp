@@ -66,9 +66,8 @@ AlignmentResult solveAlignment(const RotationPairs& pairs, const SolverOptions& 
     result.message = "the solver produced no finite estimate";
     return result;
   }
-  result.quality =
-      evaluateQuality(pairs, result.R_cam_imu, inlier, rejection, options.quality, residuals,
-                      angles_rad);
+  result.quality = evaluateQuality(pairs, result.R_cam_imu, inlier, rejection, options.quality,
+                                   residuals, angles_rad);
   result.status = result.quality.observable ? SolveStatus::kOk : SolveStatus::kNotObservable;
   if (options.method == SolverMethod::kTwoStep) {
     // The two-step can converge to a wrong fixed point (mountings far from its initial value) or

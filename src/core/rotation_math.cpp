@@ -115,8 +115,7 @@ Eigen::Matrix3d projectToSO3(const Eigen::Matrix3d& M) {
   for (int it = 0; it < 30; ++it) {
     const double det_X = cofactor(X, &C);  // X^-T = C / det_X, det_X > 0
     // Frobenius-norm scaling g = sqrt(|X^-1|_F / |X|_F) = (|C|^2 / (det^2 |X|^2))^(1/4).
-    const double gamma =
-        std::sqrt(std::sqrt(C.squaredNorm() / (det_X * det_X * X.squaredNorm())));
+    const double gamma = std::sqrt(std::sqrt(C.squaredNorm() / (det_X * det_X * X.squaredNorm())));
     const Eigen::Matrix3d X_next = (0.5 * gamma) * X + (0.5 / (gamma * det_X)) * C;
     const double change2 = (X_next - X).squaredNorm();
     X = X_next;
@@ -163,8 +162,7 @@ bool isRotationMatrix(const Eigen::Matrix3d& R, double tolerance) {
   const double o01 = r[0] * r[3] + r[1] * r[4] + r[2] * r[5];
   const double o02 = r[0] * r[6] + r[1] * r[7] + r[2] * r[8];
   const double o12 = r[3] * r[6] + r[4] * r[7] + r[5] * r[8];
-  const double deviation2 =
-      d0 * d0 + d1 * d1 + d2 * d2 + 2.0 * (o01 * o01 + o02 * o02 + o12 * o12);
+  const double deviation2 = d0 * d0 + d1 * d1 + d2 * d2 + 2.0 * (o01 * o01 + o02 * o02 + o12 * o12);
   if (!(deviation2 <= tolerance * tolerance)) return false;
   // det(R) = column 0 . (column 1 x column 2).
   const double det = r[0] * (r[4] * r[8] - r[5] * r[7]) + r[1] * (r[5] * r[6] - r[3] * r[8]) +

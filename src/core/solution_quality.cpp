@@ -40,10 +40,10 @@ Eigen::Matrix3d pairJacobian(const RotationPair& pair, const Eigen::Vector3d& re
   const double x = residual.x(), y = residual.y(), z = residual.z();
   const double angle2 = x * x + y * y + z * z;
   // c(theta): its small-angle series needs only theta^2 (no square root).
-  const double c = angle2 < 0.01 ? 1.0 / 12.0 + angle2 * (1.0 / 720.0 +
-                                                          angle2 * (1.0 / 30240.0 +
-                                                                    angle2 / 1209600.0))
-                                 : jacobianInverseCoefficient(std::sqrt(angle2));
+  const double c =
+      angle2 < 0.01
+          ? 1.0 / 12.0 + angle2 * (1.0 / 720.0 + angle2 * (1.0 / 30240.0 + angle2 / 1209600.0))
+          : jacobianInverseCoefficient(std::sqrt(angle2));
   const double cxy = c * x * y, cxz = c * x * z, cyz = c * y * z;
   const double hx = 0.5 * x, hy = 0.5 * y, hz = 0.5 * z;
   Eigen::Matrix3d common;

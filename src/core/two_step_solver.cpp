@@ -81,8 +81,7 @@ TwoStepResult solveTwoStep(const RotationPairs& pairs, const TwoStepOptions& opt
     it.iteration = n;
     // Right step: R^r_n = V2H(H1 R^l_{n-1}) pinv(H2), projected onto SO(3).
     Eigen::Matrix3d N_right;
-    Eigen::Map<Vector9>(N_right.data()) =
-        S.lazyProduct(Eigen::Map<const Vector9>(R_left.data()));
+    Eigen::Map<Vector9>(N_right.data()) = S.lazyProduct(Eigen::Map<const Vector9>(R_left.data()));
     const Eigen::Matrix3d M_right = N_right.lazyProduct(H2H2t_inv);
     it.R_right = projectWithSignFix(M_right, &it.right_sign_fixed);
     // Left step: R^l_n = pinv(H1) H2V(R^r_n H2), projected onto SO(3).
