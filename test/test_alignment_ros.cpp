@@ -122,7 +122,10 @@ TEST_F(AlignmentRos, ReplayBroadcastsTheTruthAndTheServicesWork) {
   EXPECT_EQ(status->poses_total, 7u);
   EXPECT_EQ(status->state, AlignmentStatus::CALIBRATED) << status->message;
   EXPECT_GE(status->poses_in_window, 3u);
-  EXPECT_TRUE(status->broadcast);
+  // The latest estimate is broadcast, or kept back because it is less precise than the broadcast
+  // one (no silent regression, test_broadcast_gate).
+  EXPECT_TRUE(status->broadcast || status->message.find("regression") != std::string::npos)
+      << status->message;
 
   Calibrate calibrate;
   ASSERT_TRUE(call("calibrate", &calibrate));

@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
@@ -15,6 +16,7 @@
 #include "camera_imu_alignment/calibration_report.h"
 #include "camera_imu_alignment/csv_io.h"
 #include "camera_imu_alignment/result_yaml.h"
+#include "camera_imu_alignment/ros/broadcast_gate.h"
 #include "camera_imu_alignment/rotation_math.h"
 
 namespace camera_imu_alignment {
@@ -64,55 +66,37 @@ std::string AlignmentWrapper::Impl::imuFrame() const {
   return imu_msg_frame.empty() ? "imu_link" : imu_msg_frame;
 }
 
-bool AlignmentWrapper::Impl::passesGates(const AlignmentResult& r, std::string* why) const {
-  std::ostringstream out;
-  const int poses = static_cast<int>(pipeline->windowSize());
-  const double sigma = r.quality.std_dev_deg.maxCoeff();
-  if (r.status != SolveStatus::kOk) {
-    out << r.message;
-  } else if (poses < settings.min_poses) {
-    out << poses << " poses in the window, min_poses is " << settings.min_poses;
-  } else if (r.quality.residual_rms_deg > settings.max_residual_deg) {
-    out << "residual RMS " << fixed(r.quality.residual_rms_deg, 3) << " deg > max_residual_deg "
-        << settings.max_residual_deg;
-  } else if (sigma > settings.max_std_dev_deg) {
-    out << "1-sigma " << fixed(sigma, 3) << " deg > max_std_dev_deg " << settings.max_std_dev_deg
-        << ": more poses, rotated about other axes";
-  }
-  *why = out.str();
-  return why->empty();
-}
-
 void AlignmentWrapper::Impl::onResult(const AlignmentResult& result) {
   last_result = result;
-  std::string why;
-  if (!passesGates(result, &why)) {
+  const GateOutcome gate =
+      judgeEstimate(result, pipeline->windowSize(), settings, published, recalibrating);
+  if (gate.decision == GateDecision::kReject) {
     state = result.status == SolveStatus::kNotObservable ? "not_observable"
             : recalibrating                              ? "recalibrating"
                                                          : "collecting";
-    state_message = why;
-    ROS_INFO_THROTTLE(2.0, "camera_imu_alignment: estimate not broadcast: %s", why.c_str());
+    state_message = gate.why;
+    ROS_INFO_THROTTLE(2.0, "camera_imu_alignment: estimate not broadcast: %s", gate.why.c_str());
+    publishStatus();
+    return;
+  }
+  state = "calibrated";
+  if (gate.decision == GateDecision::kKeep) {
+    state_message = "the broadcast estimate stays: " + gate.why;
     publishStatus();
     return;
   }
   accepted_result = result;
   recalibrating = false;
-  state = "calibrated";
   state_message = result.message;
-  const bool moved =
-      !broadcast_R ||
-      rad2deg(rotationAngle(broadcast_R->transpose() * result.R_cam_imu)) > settings.min_change_deg;
-  if (moved) {
-    broadcast(result.R_cam_imu);
-    std::string error;
-    if (!settings.output_file.empty() && !save(result, &error)) {
-      ROS_ERROR_THROTTLE(10.0, "camera_imu_alignment: %s", error.c_str());
-    }
+  broadcast(result.R_cam_imu, result.quality.std_dev_deg.maxCoeff());
+  std::string error;
+  if (!settings.output_file.empty() && !save(result, &error)) {
+    ROS_ERROR_THROTTLE(10.0, "camera_imu_alignment: %s", error.c_str());
   }
   publishStatus();
 }
 
-void AlignmentWrapper::Impl::broadcast(const Eigen::Matrix3d& R_cam_imu) {
+void AlignmentWrapper::Impl::broadcast(const Eigen::Matrix3d& R_cam_imu, double max_std_dev_deg) {
   geometry_msgs::TransformStamped t;
   t.header.stamp = ros::Time::now();
   // A transform parent <- child maps child-frame points into the parent frame.
@@ -127,6 +111,7 @@ void AlignmentWrapper::Impl::broadcast(const Eigen::Matrix3d& R_cam_imu) {
   }
   broadcaster.sendTransform(t);
   broadcast_R = R_cam_imu;
+  published = PublishedEstimate{R_cam_imu, max_std_dev_deg};
   inconsistent_poses = 0;  // the remount check starts over against the new estimate
   const Eigen::Vector3d rpy = rollPitchYawDeg(R_cam_imu);
   ROS_INFO("camera_imu_alignment: broadcasting %s -> %s, R_cam_imu rpy [%.3f, %.3f, %.3f] deg",
@@ -150,7 +135,7 @@ void AlignmentWrapper::Impl::loadSaved() {
     const StoredCalibration stored = readResultYaml(settings.output_file);
     if (settings.camera_frame.empty()) image_frame = stored.camera_frame;
     if (settings.imu_frame.empty()) imu_msg_frame = stored.imu_frame;
-    broadcast(stored.R_cam_imu);
+    broadcast(stored.R_cam_imu, std::numeric_limits<double>::infinity());
     state = "calibrated";
     state_message = "calibration loaded from " + settings.output_file;
     ROS_INFO("camera_imu_alignment: %s", state_message.c_str());
@@ -287,6 +272,7 @@ bool AlignmentWrapper::Impl::onReset(std_srvs::Trigger::Request&,
                                      std_srvs::Trigger::Response& res) {
   pipeline->reset();
   last_result.reset();
+  published.reset();  // starting over: the next good estimate replaces the tf, however precise
   last_pose.reset();
   inconsistent_poses = 0;
   recalibrating = false;

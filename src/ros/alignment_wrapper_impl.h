@@ -20,6 +20,7 @@
 #include "camera_imu_alignment/Calibrate.h"
 #include "camera_imu_alignment/calibration_pipeline.h"
 #include "camera_imu_alignment/ros/alignment_wrapper.h"
+#include "camera_imu_alignment/ros/broadcast_gate.h"
 #include "camera_imu_alignment/ros/wrapper_settings.h"
 #include "camera_imu_alignment/target_detector.h"
 
@@ -92,9 +93,8 @@ struct AlignmentWrapper::Impl {
   std::optional<StationaryPose> last_pose;
 
   void advertise();
-  /// Gates of WrapperSettings; false with the reason.
-  bool passesGates(const AlignmentResult& result, std::string* why) const;
-  void broadcast(const Eigen::Matrix3d& R_cam_imu);
+  std::optional<PublishedEstimate> published;  ///< judgeEstimate's reference
+  void broadcast(const Eigen::Matrix3d& R_cam_imu, double max_std_dev_deg);
   bool save(const AlignmentResult& result, std::string* error);
   void loadSaved();
   void publishStatus();
