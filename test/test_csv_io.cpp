@@ -374,6 +374,28 @@ TEST(ResultYaml, ReadOnlyDirectoryKeepsThePreviousFile) {
   EXPECT_ROTATION_NEAR_DEG(readResultYaml(path).R_cam_imu, before, 1e-9);
 }
 
+TEST(ResultYaml, CorruptSavedFileIsSetAsideAndTheNodeStartsFresh) {
+  std::string warning;
+  EXPECT_FALSE(loadSavedCalibration(tempDir() + "never_saved.yaml", &warning));
+  EXPECT_TRUE(warning.empty());
+  const std::string good = tempDir() + "saved_good.yaml";
+  const Eigen::Matrix3d X = test::axisAngle(kX, 0.4);
+  writeResultYaml(good, knownResult(X), ResultMetadata{});
+  const auto loaded = loadSavedCalibration(good, &warning);
+  ASSERT_TRUE(loaded) << warning;
+  EXPECT_ROTATION_NEAR_DEG(loaded->R_cam_imu, X, 1e-9);
+  const std::string corrupt =
+      writeTemp("saved_corrupt.yaml", "R_cam_imu:\n  quaternion_xyzw: [0, 0");
+  std::filesystem::remove(corrupt + ".bad");
+  EXPECT_FALSE(loadSavedCalibration(corrupt, &warning));
+  EXPECT_NE(warning.find("saved_corrupt.yaml"), std::string::npos) << warning;
+  EXPECT_NE(warning.find(".bad"), std::string::npos) << warning;
+  EXPECT_FALSE(std::filesystem::exists(corrupt));
+  EXPECT_TRUE(std::filesystem::exists(corrupt + ".bad"));
+  EXPECT_FALSE(loadSavedCalibration(corrupt, &warning));  // next start: nothing left to read
+  EXPECT_TRUE(warning.empty());
+}
+
 TEST(ResultYaml, ReaderErrorsNameTheFileAndTheProblem) {
   const auto read = [](const std::string& p) { return readResultYaml(p); };
   expectError(read, "/nonexistent_dir/result.yaml", -1);

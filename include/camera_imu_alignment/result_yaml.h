@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 
 #include "camera_imu_alignment/alignment_solver.h"
@@ -34,5 +35,11 @@ struct StoredCalibration {
 /// Reads R_cam_imu (quaternion_xyzw, else matrix) from a result YAML. Throws InputError naming the
 /// file and the key on any problem (missing key, not finite, not a rotation).
 StoredCalibration readResultYaml(const std::string& path);
+
+/// For a node starting up: the calibration saved at `path`, nullopt when there is no file. A file
+/// that cannot be read (corrupt, truncated, not a rotation) is renamed to `path + ".bad"`, kept for
+/// inspection and never read again, and `warning` says so; the node then starts fresh.
+std::optional<StoredCalibration> loadSavedCalibration(const std::string& path,
+                                                      std::string* warning);
 
 }  // namespace camera_imu_alignment

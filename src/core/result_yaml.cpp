@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
@@ -164,6 +165,22 @@ StoredCalibration readResultYaml(const std::string& path) {
     throw InputError(path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }
   return stored;
+}
+
+std::optional<StoredCalibration> loadSavedCalibration(const std::string& path,
+                                                      std::string* warning) {
+  warning->clear();
+  std::error_code ec;
+  if (path.empty() || !std::filesystem::exists(path, ec)) return std::nullopt;
+  try {
+    return readResultYaml(path);
+  } catch (const std::exception& e) {
+    const std::string aside = path + ".bad";
+    std::filesystem::rename(path, aside, ec);
+    *warning = std::string(e.what()) + (ec ? "; could not move it aside: " + ec.message()
+                                           : "; moved aside to " + aside + ", starting fresh");
+    return std::nullopt;
+  }
 }
 
 }  // namespace camera_imu_alignment

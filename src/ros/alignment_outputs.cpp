@@ -130,18 +130,18 @@ bool AlignmentWrapper::Impl::save(const AlignmentResult& result, std::string* er
 }
 
 void AlignmentWrapper::Impl::loadSaved() {
-  if (settings.output_file.empty() || !std::filesystem::exists(settings.output_file)) return;
-  try {
-    const StoredCalibration stored = readResultYaml(settings.output_file);
-    if (settings.camera_frame.empty()) image_frame = stored.camera_frame;
-    if (settings.imu_frame.empty()) imu_msg_frame = stored.imu_frame;
-    broadcast(stored.R_cam_imu, std::numeric_limits<double>::infinity());
-    state = "calibrated";
-    state_message = "calibration loaded from " + settings.output_file;
-    ROS_INFO("camera_imu_alignment: %s", state_message.c_str());
-  } catch (const std::exception& e) {
-    ROS_WARN("camera_imu_alignment: saved calibration not loaded: %s", e.what());
-  }
+  std::string warning;
+  const std::optional<StoredCalibration> stored =
+      loadSavedCalibration(settings.output_file, &warning);
+  if (!warning.empty())
+    ROS_WARN("camera_imu_alignment: saved calibration not loaded: %s", warning.c_str());
+  if (!stored) return;
+  if (settings.camera_frame.empty()) image_frame = stored->camera_frame;
+  if (settings.imu_frame.empty()) imu_msg_frame = stored->imu_frame;
+  broadcast(stored->R_cam_imu, std::numeric_limits<double>::infinity());
+  state = "calibrated";
+  state_message = "calibration loaded from " + settings.output_file;
+  ROS_INFO("camera_imu_alignment: %s", state_message.c_str());
 }
 
 void AlignmentWrapper::Impl::publishStatus() {
