@@ -14,6 +14,7 @@
 #include <fstream>
 #include <future>
 #include <optional>
+#include <tuple>
 
 #include "camera_imu_alignment/AlignmentStatus.h"
 #include "camera_imu_alignment/Calibrate.h"
@@ -225,6 +226,53 @@ TEST_F(AlignmentRos, ManualCaptureTakesOnlyTheArmedRest) {
   std::system(("kill $(cat " + temp("manual.pid") + ")").c_str());
   ASSERT_TRUE(last) << test::readTextFile(temp("manual.log"));
   EXPECT_EQ(last->poses_total, 1u) << test::readTextFile(temp("manual.log"));
+}
+
+TEST_F(AlignmentRos, RealImuOnlyBagsKeepItWaitingForTheCameraWithoutATf) {
+  // ../shared/realdata/imu_tools_bags (no camera): a phidgets IMU lying upside down with NaN
+  // magnetometer samples, an AR.Drone, a SparkFun Razor with leading-slash frame ids. Played one
+  // after the other (their clocks jump back) into a node of its own.
+  const std::string dir = std::string(CIA_REALDATA_DIR) + "/imu_tools_bags/";
+  if (!std::filesystem::exists(dir)) GTEST_SKIP() << dir << " not found";
+  const std::string node = std::string(ALIGNMENT_NODE_EXE) +
+                           " __name:=real _target_file:=" + TARGET_YAML +
+                           " _load_on_start:=false _camera_frame:=real_cam" +
+                           " _imu_frame:=real_imu imu/data_raw:=real/imu/data_raw" +
+                           " imu/mag:=real/imu/mag camera/image_raw:=real/camera/image_raw" +
+                           " camera/camera_info:=real/camera/camera_info >" + temp("real.log") +
+                           " 2>&1 & echo $! >" + temp("real.pid");
+  ASSERT_EQ(std::system(node.c_str()), 0);
+  ASSERT_TRUE(ros::service::waitForService("/real/calibrate", ros::Duration(30.0)));
+  ros::NodeHandle nh;
+  std::optional<AlignmentStatus> last;
+  std::uint32_t most_rests = 0;
+  auto sub =
+      nh.subscribe<AlignmentStatus>("/real/status", 100, [&](const AlignmentStatus::ConstPtr& m) {
+        last = *m;
+        most_rests = std::max(most_rests, m->rests_total);
+      });
+  for (const auto& [bag, imu, mag] :
+       {std::tuple<std::string, std::string, std::string>{"phidgets_imu_upside_down.bag",
+                                                          "/imu/data_raw", "/imu/mag"},
+        {"ardrone_imu.bag", "/ardrone/imu", "/ardrone/mag"},
+        {"sparkfun_razor.bag", "/imu/data_raw", "/imu/mag"}}) {
+    const std::string cmd = "rosbag play --clock --quiet --delay 1 --rate 8 " + dir + bag + " " +
+                            imu + ":=/real/imu/data_raw " + mag + ":=/real/imu/mag >/dev/null 2>&1";
+    EXPECT_EQ(std::system(cmd.c_str()), 0) << bag;
+  }
+  // Still running, still waiting for the camera, rests seen, no tf ever.
+  const bool alive =
+      std::system(("kill -0 $(cat " + temp("real.pid") + ") 2>/dev/null").c_str()) == 0;
+  std::system(("kill $(cat " + temp("real.pid") + ") 2>/dev/null").c_str());
+  const std::string log = test::readTextFile(temp("real.log"));
+  EXPECT_TRUE(alive) << log;
+  ASSERT_TRUE(last) << log;
+  EXPECT_EQ(last->state, AlignmentStatus::WAITING_FOR_DATA) << last->message;
+  EXPECT_NE(last->message.find("camera"), std::string::npos) << last->message;
+  EXPECT_GT(most_rests, 0u) << log;
+  EXPECT_EQ(last->poses_total, 0u);
+  EXPECT_FALSE(buffer_.canTransform("real_cam", "real_imu", ros::Time(0)));
+  EXPECT_EQ(log.find("nan"), std::string::npos) << log;
 }
 
 }  // namespace

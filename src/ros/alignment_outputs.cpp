@@ -148,14 +148,22 @@ void AlignmentWrapper::Impl::publishStatus() {
   AlignmentStatus s;
   s.header.stamp = last_stamp_s > 0.0 ? ros::Time(last_stamp_s) : ros::Time::now();
   s.header.frame_id = cameraFrame();
-  if (state == "waiting_for_data" && pipeline->imuSamples() > 0 && pipeline->hasIntrinsics()) {
-    state = "collecting";
-    state_message = "waiting for stationary poses";
+  if (state == "waiting_for_data") {
+    if (pipeline->imuSamples() == 0) {
+      state_message = "waiting for IMU data on " + imu_sub.getTopic();
+    } else if (!pipeline->hasIntrinsics() && pipeline->frames() == 0) {
+      state_message = "waiting for the camera: nothing on " + camera_sub.getTopic() + " / " +
+                      camera_sub.getInfoTopic() + " / " + camera_pose_sub.getTopic() + " yet";
+    } else {
+      state = "collecting";
+      state_message = "waiting for stationary poses";
+    }
   }
   s.state = state;
   s.message = state_message;
   s.poses_in_window = static_cast<std::uint32_t>(pipeline->windowSize());
   s.poses_total = static_cast<std::uint32_t>(pipeline->poses().size());
+  s.rests_total = static_cast<std::uint32_t>(pipeline->segments().size());
   const AlignmentResult* r = last_result ? &*last_result : nullptr;
   s.q_cam_imu.w = 1.0;
   if (r) {
