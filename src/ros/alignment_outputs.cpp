@@ -9,7 +9,6 @@
 #include <filesystem>
 #include <limits>
 #include <opencv2/imgproc.hpp>
-#include <sstream>
 
 #include "alignment_wrapper_impl.h"
 #include "camera_imu_alignment/AlignmentStatus.h"
@@ -27,14 +26,6 @@ geometry_msgs::Quaternion toMsg(const Eigen::Matrix3d& R) {
   geometry_msgs::Quaternion out;
   out.x = q.x(), out.y = q.y(), out.z = q.z(), out.w = q.w();
   return out;
-}
-
-std::string fixed(double value, int precision) {
-  std::ostringstream out;
-  out.setf(std::ios::fixed);
-  out.precision(precision);
-  out << value;
-  return out.str();
 }
 
 }  // namespace
