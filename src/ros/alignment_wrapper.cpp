@@ -50,16 +50,22 @@ bool AlignmentWrapper::Impl::acceptStamp(const ros::Time& stamp, const char* top
     ROS_WARN_THROTTLE(5.0, "camera_imu_alignment: %s: message without a stamp dropped", topic);
     return false;
   }
-  if (last_stamp_s > 0.0 && t < last_stamp_s - 1.0) {
+  // Per topic: a camera's stamps may lag the IMU's by its latency; only a topic going back on
+  // itself is a jump.
+  double& last = last_stamp_by_topic[topic];
+  if (last > 0.0 && t < last - 1.0) {
     ROS_WARN(
         "camera_imu_alignment: %s: time jumped back by %.1f s (bag loop or restarted "
         "clock): buffers reset, the broadcast calibration is kept",
-        topic, last_stamp_s - t);
+        topic, last - t);
     pipeline->reset();
     inconsistent_poses = 0;
+    last_stamp_by_topic.clear();
+    last_stamp_by_topic[topic] = t;
     last_stamp_s = t;
     return true;
   }
+  last = std::max(last, t);
   last_stamp_s = std::max(last_stamp_s, t);
   return true;
 }

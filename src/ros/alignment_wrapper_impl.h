@@ -14,6 +14,7 @@
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_broadcaster.h>
 
+#include <map>
 #include <memory>
 #include <optional>
 
@@ -38,13 +39,14 @@ struct AlignmentWrapper::Impl {
   image_transport::ImageTransport transport;
   ros::Subscriber imu_sub, mag_sub, camera_pose_sub;
   image_transport::CameraSubscriber camera_sub;
-  std::string image_frame, imu_msg_frame;  ///< frame_ids seen on the inputs
-  sensor_msgs::CameraInfo last_info;       ///< the intrinsics in use
-  double last_stamp_s = -1.0;              ///< newest input stamp (clock jumps)
-  bool reset_requested = false;            ///< applied after the pipeline call returns
-  bool capture_armed = false;              ///< manual_capture: ~capture_pose called for this rest
-  ros::WallTime last_imu_wall;             ///< receipt time of the newest IMU message
-  bool input_stopped = true;               ///< no IMU for a while: the rest in progress was closed
+  std::string image_frame, imu_msg_frame;             ///< frame_ids seen on the inputs
+  sensor_msgs::CameraInfo last_info;                  ///< the intrinsics in use
+  double last_stamp_s = -1.0;                         ///< newest input stamp (status)
+  std::map<std::string, double> last_stamp_by_topic;  ///< newest stamp per topic (clock jumps)
+  bool reset_requested = false;                       ///< applied after the pipeline call returns
+  bool capture_armed = false;   ///< manual_capture: ~capture_pose called for this rest
+  ros::WallTime last_imu_wall;  ///< receipt time of the newest IMU message
+  bool input_stopped = true;    ///< no IMU for a while: the rest in progress was closed
   ros::WallTimer stale_timer;
   /// IMU silent for 2 s of wall time (a bag ended, a driver stopped): close the rest in progress
   /// so that the last pose counts.
