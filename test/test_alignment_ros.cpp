@@ -42,10 +42,11 @@ std::string simulate(const std::string& name, const std::string& options) {
   return bag;
 }
 
-/// Plays a bag with --clock (blocking, in the background through std::async).
-std::future<int> play(const std::string& bag, double rate) {
+/// Plays a bag with --clock (blocking, in the background through std::async); `remaps` are
+/// rosbag play's "from:=to" arguments.
+std::future<int> play(const std::string& bag, double rate, const std::string& remaps = "") {
   const std::string cmd = "rosbag play --clock --quiet --delay 1 --rate " + std::to_string(rate) +
-                          " " + bag + " >/dev/null 2>&1";
+                          " " + bag + " " + remaps + " >/dev/null 2>&1";
   return std::async(std::launch::async, [cmd] { return std::system(cmd.c_str()); });
 }
 
@@ -81,12 +82,13 @@ bool call(const std::string& name, Srv* srv) {
   return ros::service::call(kNode + "/" + name, *srv);
 }
 
-/// The latest ~status, polled until `pred` holds or `timeout_s` (wall) passes.
+/// The latest ~status of `node`, polled until `pred` holds or `timeout_s` (wall) passes.
 std::optional<AlignmentStatus> waitForStatus(
-    double timeout_s, const std::function<bool(const AlignmentStatus&)>& pred) {
+    double timeout_s, const std::function<bool(const AlignmentStatus&)>& pred,
+    const std::string& node = kNode) {
   ros::NodeHandle nh;
   std::optional<AlignmentStatus> last;
-  auto sub = nh.subscribe<AlignmentStatus>(kNode + "/status", 10,
+  auto sub = nh.subscribe<AlignmentStatus>(node + "/status", 10,
                                            [&](const AlignmentStatus::ConstPtr& m) { last = *m; });
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   while (std::chrono::steady_clock::now() < deadline && ros::ok()) {
@@ -95,6 +97,40 @@ std::optional<AlignmentStatus> waitForStatus(
   }
   return last;
 }
+
+/// The node's input topics remapped under `prefix` ("from:=to" arguments).
+std::string remapsUnder(const std::string& prefix) {
+  std::string out;
+  for (const char* topic : {"imu/data_raw", "imu/mag", "camera/image_raw", "camera/camera_info"}) {
+    out += std::string(" ") + topic + ":=" + prefix + "/" + topic;
+  }
+  return out;
+}
+
+/// A further alignment_node started by a test, named `name`, with `arguments` (parameters and
+/// remaps); stopped when it goes out of scope, also when an assertion ends the test early.
+class ExtraNode {
+ public:
+  ExtraNode(const std::string& name, const std::string& arguments) : name_(name) {
+    const std::string cmd = std::string(ALIGNMENT_NODE_EXE) + " __name:=" + name +
+                            " _target_file:=" + TARGET_YAML + " " + arguments + " >" + log_path() +
+                            " 2>&1 & echo $! >" + pid_path();
+    started_ = std::system(cmd.c_str()) == 0;
+  }
+  ~ExtraNode() { stop(); }
+  void stop() const { std::system(("kill $(cat " + pid_path() + ") 2>/dev/null").c_str()); }
+  bool started() const { return started_; }
+  bool alive() const {
+    return std::system(("kill -0 $(cat " + pid_path() + ") 2>/dev/null").c_str()) == 0;
+  }
+  std::string log() const { return test::readTextFile(log_path()); }
+
+ private:
+  std::string log_path() const { return temp(name_ + ".log"); }
+  std::string pid_path() const { return temp(name_ + ".pid"); }
+  std::string name_;
+  bool started_ = false;
+};
 
 class AlignmentRos : public ::testing::Test {
  protected:
@@ -166,14 +202,12 @@ TEST_F(AlignmentRos, ReplayBroadcastsTheTruthAndTheServicesWork) {
   EXPECT_EQ(after_reset.response.poses, 0u);
 
   // A restarted node (another name and frames) broadcasts the saved calibration at once.
-  const std::string restart =
-      std::string(ALIGNMENT_NODE_EXE) + " __name:=restarted _target_file:=" + TARGET_YAML +
-      " _output_file:=" + saved + " _camera_frame:=restored_cam _imu_frame:=restored_imu" + " >" +
-      temp("restarted.log") + " 2>&1 & echo $! >" + temp("restarted.pid");
-  ASSERT_EQ(std::system(restart.c_str()), 0);
+  const ExtraNode restarted(
+      "restarted",
+      "_output_file:=" + saved + " _camera_frame:=restored_cam _imu_frame:=restored_imu");
+  ASSERT_TRUE(restarted.started());
   const auto restored = waitForTf(buffer_, "restored_cam", "restored_imu", 30.0);
-  std::system(("kill $(cat " + temp("restarted.pid") + ")").c_str());
-  ASSERT_TRUE(restored) << test::readTextFile(temp("restarted.log"));
+  ASSERT_TRUE(restored) << restarted.log();
   EXPECT_LT(angleDeg(*restored, R_true), 0.2);
 }
 
@@ -197,35 +231,20 @@ TEST_F(AlignmentRos, ManualCaptureTakesOnlyTheArmedRest) {
   // A second node on its own topics with manual_capture: armed once before the bag, so the first
   // rest becomes a pose and the later ones do not.
   const std::string bag = simulate("manual", "--scenario nominal --seed 47 --num-poses 4");
-  const std::string node =
-      std::string(ALIGNMENT_NODE_EXE) + " __name:=manual _target_file:=" + TARGET_YAML +
-      " _manual_capture:=true _load_on_start:=false imu/data_raw:=manual/imu/data_raw" +
-      " imu/mag:=manual/imu/mag camera/image_raw:=manual/camera/image_raw" +
-      " camera/camera_info:=manual/camera/camera_info >" + temp("manual.log") +
-      " 2>&1 & echo $! >" + temp("manual.pid");
-  ASSERT_EQ(std::system(node.c_str()), 0);
+  const ExtraNode manual("manual",
+                         "_manual_capture:=true _load_on_start:=false" + remapsUnder("manual"));
+  ASSERT_TRUE(manual.started());
   ASSERT_TRUE(ros::service::waitForService("/manual/capture_pose", ros::Duration(30.0)));
   std_srvs::Trigger capture;
   ASSERT_TRUE(ros::service::call("/manual/capture_pose", capture));
   EXPECT_TRUE(capture.response.success) << capture.response.message;
-  const std::string cmd = "rosbag play --clock --quiet --delay 1 --rate 3 " + bag +
-                          " imu/data_raw:=manual/imu/data_raw imu/mag:=manual/imu/mag" +
-                          " camera/image_raw:=manual/camera/image_raw" +
-                          " camera/camera_info:=manual/camera/camera_info >/dev/null 2>&1";
-  EXPECT_EQ(std::system(cmd.c_str()), 0);
+  EXPECT_EQ(play(bag, 3.0, remapsUnder("manual")).get(), 0);
   // All rests but the last are judged while the bag plays (the last one, unarmed, would not count
   // either); the status is latched.
-  ros::NodeHandle nh;
-  std::optional<AlignmentStatus> last;
-  auto sub = nh.subscribe<AlignmentStatus>("/manual/status", 10,
-                                           [&](const AlignmentStatus::ConstPtr& m) { last = *m; });
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(15);
-  while (std::chrono::steady_clock::now() < deadline && !(last && last->poses_total >= 1)) {
-    ros::WallDuration(0.1).sleep();
-  }
-  std::system(("kill $(cat " + temp("manual.pid") + ")").c_str());
-  ASSERT_TRUE(last) << test::readTextFile(temp("manual.log"));
-  EXPECT_EQ(last->poses_total, 1u) << test::readTextFile(temp("manual.log"));
+  const auto last = waitForStatus(
+      15.0, [](const AlignmentStatus& s) { return s.poses_total >= 1; }, "/manual");
+  ASSERT_TRUE(last) << manual.log();
+  EXPECT_EQ(last->poses_total, 1u) << manual.log();
 }
 
 TEST_F(AlignmentRos, RealImuOnlyBagsKeepItWaitingForTheCameraWithoutATf) {
@@ -234,14 +253,9 @@ TEST_F(AlignmentRos, RealImuOnlyBagsKeepItWaitingForTheCameraWithoutATf) {
   // after the other (their clocks jump back) into a node of its own.
   const std::string dir = std::string(CIA_REALDATA_DIR) + "/imu_tools_bags/";
   if (!std::filesystem::exists(dir)) GTEST_SKIP() << dir << " not found";
-  const std::string node = std::string(ALIGNMENT_NODE_EXE) +
-                           " __name:=real _target_file:=" + TARGET_YAML +
-                           " _load_on_start:=false _camera_frame:=real_cam" +
-                           " _imu_frame:=real_imu imu/data_raw:=real/imu/data_raw" +
-                           " imu/mag:=real/imu/mag camera/image_raw:=real/camera/image_raw" +
-                           " camera/camera_info:=real/camera/camera_info >" + temp("real.log") +
-                           " 2>&1 & echo $! >" + temp("real.pid");
-  ASSERT_EQ(std::system(node.c_str()), 0);
+  ExtraNode real("real", "_load_on_start:=false _camera_frame:=real_cam _imu_frame:=real_imu" +
+                             remapsUnder("real"));
+  ASSERT_TRUE(real.started());
   ASSERT_TRUE(ros::service::waitForService("/real/calibrate", ros::Duration(30.0)));
   ros::NodeHandle nh;
   std::optional<AlignmentStatus> last;
@@ -256,15 +270,14 @@ TEST_F(AlignmentRos, RealImuOnlyBagsKeepItWaitingForTheCameraWithoutATf) {
                                                           "/imu/data_raw", "/imu/mag"},
         {"ardrone_imu.bag", "/ardrone/imu", "/ardrone/mag"},
         {"sparkfun_razor.bag", "/imu/data_raw", "/imu/mag"}}) {
-    const std::string cmd = "rosbag play --clock --quiet --delay 1 --rate 8 " + dir + bag + " " +
-                            imu + ":=/real/imu/data_raw " + mag + ":=/real/imu/mag >/dev/null 2>&1";
-    EXPECT_EQ(std::system(cmd.c_str()), 0) << bag;
+    EXPECT_EQ(play(dir + bag, 8.0, imu + ":=/real/imu/data_raw " + mag + ":=/real/imu/mag").get(),
+              0)
+        << bag;
   }
   // Still running, still waiting for the camera, rests seen, no tf ever.
-  const bool alive =
-      std::system(("kill -0 $(cat " + temp("real.pid") + ") 2>/dev/null").c_str()) == 0;
-  std::system(("kill $(cat " + temp("real.pid") + ") 2>/dev/null").c_str());
-  const std::string log = test::readTextFile(temp("real.log"));
+  const bool alive = real.alive();
+  real.stop();
+  const std::string log = real.log();
   EXPECT_TRUE(alive) << log;
   ASSERT_TRUE(last) << log;
   EXPECT_EQ(last->state, AlignmentStatus::WAITING_FOR_DATA) << last->message;

@@ -29,9 +29,9 @@ namespace cia = camera_imu_alignment;
 
 namespace {
 
-constexpr int kExitOk = 0;
-constexpr int kExitBadInput = 2;
-constexpr int kExitNotEnough = 3;
+using cia::kExitBadInput;
+using cia::kExitNotEnoughInformation;
+using cia::kExitOk;
 
 const char* kUsage =
     "usage: calibrate_bag --bag FILE.bag --target TARGET.yaml [--config PARAMS.yaml]\n"
@@ -294,7 +294,7 @@ int run(const cia::CliArgs& args) {
   const cia::SolveStatus status = report.result.status;
   if (status != cia::SolveStatus::kOk) {
     std::cerr << "calibrate_bag: " << report.result.message << "\n";
-    return kExitNotEnough;  // the bag was read; it did not hold enough information
+    return kExitNotEnoughInformation;  // the bag was read; it did not hold enough information
   }
   if (args.has("--output")) {
     try {

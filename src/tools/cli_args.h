@@ -9,6 +9,11 @@
 
 namespace camera_imu_alignment {
 
+/// Exit codes of the tools (shared/CONVENTIONS.md).
+constexpr int kExitOk = 0;
+constexpr int kExitBadInput = 2;              ///< bad input or usage; the message names the culprit
+constexpr int kExitNotEnoughInformation = 3;  ///< not observable, or the two-step did not fit
+
 class UsageError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;

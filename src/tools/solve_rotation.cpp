@@ -16,9 +16,9 @@ namespace cia = camera_imu_alignment;
 
 namespace {
 
-constexpr int kExitOk = 0;
-constexpr int kExitBadInput = 2;
-constexpr int kExitNotObservable = 3;
+using cia::kExitBadInput;
+using cia::kExitNotEnoughInformation;
+using cia::kExitOk;
 
 const char* kUsage =
     "usage: solve_rotation (--pairs FILE.csv | --poses FILE.csv) [--method optimal|two_step]\n"
@@ -105,7 +105,7 @@ int run(int argc, char** argv) {
     if (pairs.empty()) {
       std::cerr << "not enough information: " << args.get("--poses")
                 << " has a single pose; record at least 3 poses rotated about two different axes\n";
-      return kExitNotObservable;
+      return kExitNotEnoughInformation;
     }
   }
 
@@ -130,7 +130,7 @@ int run(int argc, char** argv) {
   if (result.status == cia::SolveStatus::kNotObservable ||
       result.status == cia::SolveStatus::kPoorFit) {
     std::cerr << result.message << "\n";
-    return kExitNotObservable;
+    return kExitNotEnoughInformation;
   }
   return kExitOk;
 }
