@@ -63,9 +63,12 @@ inline PipelineRun feedPipeline(std::unique_ptr<simulation::SimulationRun> simul
   std::vector<AlignmentResult>* results = &out.results;
   callbacks.on_result = [results](const AlignmentResult& r) { results->push_back(r); };
   std::vector<std::string>* details = &out.reject_details;
-  callbacks.on_reject = [details](RejectReason reason, const std::string& detail) {
-    if (details->size() < 200)
-      details->push_back(std::string(rejectReasonName(reason)) + ": " + detail);
+  callbacks.on_reject = [details](RejectReason reason, InputStream stream,
+                                  const std::string& detail) {
+    if (details->size() < 200) {
+      details->push_back(std::string(inputStreamName(stream)) + ": " + rejectReasonName(reason) +
+                         ": " + detail);
+    }
   };
   out.pipeline = std::make_unique<CalibrationPipeline>(target, settings, callbacks);
   CalibrationPipeline& pipeline = *out.pipeline;

@@ -2,8 +2,14 @@
 // played with --clock under use_sim_time; the static tf, the services, a remount and a restart
 // from the saved file are checked against the simulator's truth. Waits poll with wall-clock
 // deadlines (the sim clock stops with the bag); no fixed sleeps decide anything.
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <geometry_msgs/PoseStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/Imu.h>
+#include <sensor_msgs/MagneticField.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/transform_listener.h>
 
@@ -13,6 +19,9 @@
 #include <filesystem>
 #include <fstream>
 #include <future>
+#include <limits>
+#include <map>
+#include <mutex>
 #include <optional>
 #include <tuple>
 
@@ -101,10 +110,58 @@ std::optional<AlignmentStatus> waitForStatus(
 /// The node's input topics remapped under `prefix` ("from:=to" arguments).
 std::string remapsUnder(const std::string& prefix) {
   std::string out;
-  for (const char* topic : {"imu/data_raw", "imu/mag", "camera/image_raw", "camera/camera_info"}) {
+  for (const char* topic :
+       {"imu/data_raw", "imu/mag", "camera/image_raw", "camera/camera_info", "camera_pose"}) {
     out += std::string(" ") + topic + ":=" + prefix + "/" + topic;
   }
   return out;
+}
+
+/// The key/values of `node`'s /diagnostics status, polled until `pred` holds or `timeout_s` (wall).
+std::map<std::string, std::string> waitForDiagnostics(
+    const std::string& node, double timeout_s,
+    const std::function<bool(const std::map<std::string, std::string>&)>& pred) {
+  ros::NodeHandle nh;
+  std::map<std::string, std::string> last;
+  std::mutex mutex;
+  auto sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 20, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
+        for (const auto& status : m->status) {
+          if (status.name.find(node) == std::string::npos) continue;
+          std::lock_guard<std::mutex> lock(mutex);
+          last.clear();
+          for (const auto& kv : status.values) last[kv.key] = kv.value;
+          last["summary"] = status.message;
+        }
+      });
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (std::chrono::steady_clock::now() < deadline && ros::ok()) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (!last.empty() && pred(last)) return last;
+    }
+    ros::WallDuration(0.1).sleep();
+  }
+  std::lock_guard<std::mutex> lock(mutex);
+  return last;
+}
+
+/// A diagnostics value as a count (-1 when missing).
+long countOf(const std::map<std::string, std::string>& values, const std::string& key) {
+  const auto it = values.find(key);
+  return it == values.end() ? -1 : std::stol(it->second);
+}
+
+/// Waits until `pub` has a subscriber (the node under test connected).
+bool connected(const ros::Publisher& pub) {
+  for (int i = 0; i < 300 && pub.getNumSubscribers() == 0; ++i) ros::WallDuration(0.1).sleep();
+  return pub.getNumSubscribers() > 0;
+}
+
+/// The duration of a bag (s), from rosbag info.
+double bagDuration(const std::string& bag) {
+  const test::ToolRun r = test::runTool("rosbag info -y -k duration " + bag);
+  return r.exit_code == 0 ? std::stod(r.out) : 0.0;
 }
 
 /// A further alignment_node started by a test, named `name`, with `arguments` (parameters and
@@ -274,6 +331,10 @@ TEST_F(AlignmentRos, RealImuOnlyBagsKeepItWaitingForTheCameraWithoutATf) {
               0)
         << bag;
   }
+  // The phidgets bag's NaN magnetometer samples are counted, not used.
+  const auto values = waitForDiagnostics(
+      "real", 10.0, [](const auto& v) { return countOf(v, "rejected non_finite") > 0; });
+  EXPECT_GT(countOf(values, "rejected non_finite"), 0);
   // Still running, still waiting for the camera, rests seen, no tf ever.
   const bool alive = real.alive();
   real.stop();
@@ -286,6 +347,180 @@ TEST_F(AlignmentRos, RealImuOnlyBagsKeepItWaitingForTheCameraWithoutATf) {
   EXPECT_EQ(last->poses_total, 0u);
   EXPECT_FALSE(buffer_.canTransform("real_cam", "real_imu", ros::Time(0)));
   EXPECT_EQ(log.find("nan"), std::string::npos) << log;
+  // The sparkfun_razor's frame ids "/imu" and "/magnetometer" were noticed.
+  EXPECT_NE(log.find("starts with '/'"), std::string::npos) << log;
+  EXPECT_NE(log.find("'magnetometer'"), std::string::npos) << log;
+}
+
+TEST_F(AlignmentRos, HostileInputsAreCountedByReasonAndNothingBreaks) {
+  // Every kind of bad message, sent to a node of its own; each is refused, counted under its
+  // reason in /diagnostics and warned about naming the topic; the node keeps running.
+  ExtraNode node("hostile", "_load_on_start:=false" + remapsUnder("hostile"));
+  ASSERT_TRUE(node.started());
+  ros::NodeHandle nh;
+  auto imu_pub = nh.advertise<sensor_msgs::Imu>("/hostile/imu/data_raw", 100);
+  auto mag_pub = nh.advertise<sensor_msgs::MagneticField>("/hostile/imu/mag", 100);
+  auto image_pub = nh.advertise<sensor_msgs::Image>("/hostile/camera/image_raw", 100);
+  auto info_pub = nh.advertise<sensor_msgs::CameraInfo>("/hostile/camera/camera_info", 100);
+  auto pose_pub = nh.advertise<geometry_msgs::PoseStamped>("/hostile/camera_pose", 100);
+  for (const ros::Publisher* pub : {&imu_pub, &mag_pub, &image_pub, &info_pub, &pose_pub}) {
+    ASSERT_TRUE(connected(*pub)) << pub->getTopic() << "\n" << node.log();
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const auto pause = [] { ros::WallDuration(0.02).sleep(); };
+  const auto imu = [&](double t, double ax, double ay, double az, double gx = 0.0) {
+    sensor_msgs::Imu m;
+    m.header.stamp = ros::Time(t);
+    m.header.frame_id = "/imu";  // leading slash, as the sparkfun_razor bag
+    m.linear_acceleration.x = ax;
+    m.linear_acceleration.y = ay;
+    m.linear_acceleration.z = az;
+    m.angular_velocity.x = gx;
+    m.orientation_covariance[0] = -1.0;
+    imu_pub.publish(m);
+    pause();
+  };
+  imu(100.00, 0.0, 0.0, 9.81, nan);                                    // non_finite
+  imu(100.01, std::numeric_limits<double>::infinity(), 0.0, 9.81);     // non_finite
+  imu(100.02, 0.0, 0.0, nan);                                          // non_finite
+  imu(100.03, 0.0, 0.0, 0.0);                                          // zero_vector
+  imu(0.0, 0.0, 0.0, 9.81);                                            // missing_stamp
+  for (int i = 0; i < 20; ++i) imu(101.0 + 0.01 * i, 0.0, 0.0, 9.81);  // good
+  imu(101.19, 0.0, 0.0, 9.81);                                         // duplicate_stamp
+  imu(100.70, 0.0, 0.0, 9.81);                                         // stamp_backwards
+  const auto mag = [&](double t, double x, double z) {
+    sensor_msgs::MagneticField m;
+    m.header.stamp = ros::Time(t);
+    m.header.frame_id = "/magnetometer";  // another frame than the IMU's
+    m.magnetic_field.x = x;
+    m.magnetic_field.z = z;
+    mag_pub.publish(m);
+    pause();
+  };
+  mag(101.0, 0.2, -0.4);    // gauss: magnetic_units
+  mag(101.1, 20.0, -40.0);  // microtesla: magnetic_units
+  mag(101.2, 0.0, 0.0);     // zero_vector
+  mag(101.3, 2e-5, -4e-5);  // good
+  const auto camera = [&](double t, std::uint32_t w, std::uint32_t h, const std::string& encoding,
+                          bool zero_k, std::size_t bytes) {
+    sensor_msgs::CameraInfo info;
+    info.header.stamp = ros::Time(t);
+    info.header.frame_id = "camera_optical";
+    info.width = 64;
+    info.height = 48;
+    info.distortion_model = "plumb_bob";
+    info.D = {0.0, 0.0, 0.0, 0.0, 0.0};
+    if (!zero_k) info.K = {50.0, 0.0, 32.0, 0.0, 50.0, 24.0, 0.0, 0.0, 1.0};
+    sensor_msgs::Image image;
+    image.header = info.header;
+    image.width = w;
+    image.height = h;
+    image.encoding = encoding;
+    image.step = w;
+    image.data.assign(bytes, 0);
+    info_pub.publish(info);
+    image_pub.publish(image);
+    pause();
+  };
+  camera(101.02, 64, 48, "mono8", true, 64 * 48);         // bad_camera_info
+  camera(101.04, 32, 24, "mono8", false, 32 * 24);        // bad_image: not the camera info's size
+  camera(101.06, 64, 48, "bayer_rggb8", false, 64 * 48);  // bad_image: encoding
+  camera(101.08, 64, 48, "mono8", false, 0);              // bad_image: no data
+  geometry_msgs::PoseStamped pose;
+  pose.header.stamp = ros::Time(101.1);
+  pose.pose.orientation.w = 2.0;  // non_finite: not a unit quaternion
+  pose_pub.publish(pose);
+
+  const std::map<std::string, long> expected = {
+      {"rejected non_finite", 4},      {"rejected zero_vector", 2},
+      {"rejected missing_stamp", 1},   {"rejected duplicate_stamp", 1},
+      {"rejected stamp_backwards", 1}, {"rejected magnetic_units", 2},
+      {"rejected bad_camera_info", 1}, {"rejected bad_image", 3}};
+  const auto values = waitForDiagnostics("hostile", 30.0, [&](const auto& v) {
+    for (const auto& [key, n] : expected) {
+      if (countOf(v, key) != n) return false;
+    }
+    return true;
+  });
+  for (const auto& [key, n] : expected) EXPECT_EQ(countOf(values, key), n) << key;
+  EXPECT_EQ(countOf(values, "imu samples"), 20);
+  const auto status = waitForStatus(
+      5.0, [](const auto&) { return true; }, "/hostile");
+  ASSERT_TRUE(status);
+  EXPECT_FALSE(status->has_estimate);
+  const bool alive = node.alive();
+  node.stop();
+  const std::string log = node.log();
+  EXPECT_TRUE(alive) << log;
+  for (const char* warning :
+       {"/hostile/imu/data_raw: rejected (non_finite)",
+        "/hostile/imu/mag: rejected (magnetic_units)",
+        "/hostile/camera/image_raw: rejected (bad_image)",
+        "/hostile/camera/camera_info: rejected (bad_camera_info)",
+        "/hostile/camera_pose: rejected (non_finite)", "starts with '/'", "'magnetometer'"}) {
+    EXPECT_NE(log.find(warning), std::string::npos) << warning << "\n" << log;
+  }
+  EXPECT_EQ(log.find("nan"), std::string::npos) << log;
+  EXPECT_FALSE(buffer_.canTransform("camera_optical", "imu", ros::Time(0)));
+}
+
+TEST_F(AlignmentRos, InputsStoppingAndComingBackAndAnUnwritableOutput) {
+  // One bag played in parts: everything; the IMU alone; the camera alone; a pause with nothing;
+  // everything again. The node keeps going and calibrates from the poses around the gaps. Its
+  // output_file lies under a regular file: every save fails with a clear error, nothing else does.
+  const std::string bag = simulate("stop_go", "--scenario nominal --seed 53 --num-poses 12");
+  const Eigen::Matrix3d R_true =
+      readResultYaml(bag.substr(0, bag.size() - 4) + ".truth.yaml").R_cam_imu;
+  const std::string blocker = temp("not_a_directory");
+  std::ofstream(blocker) << "a file where the output's directory should be\n";
+  ExtraNode node("stop_go", "_load_on_start:=false _output_file:=" + blocker +
+                                "/calibration.yaml _camera_frame:=sg_cam _imu_frame:=sg_imu" +
+                                remapsUnder("stop_go"));
+  ASSERT_TRUE(node.started());
+  ASSERT_TRUE(ros::service::waitForService("/stop_go/save", ros::Duration(30.0)));
+  const double duration = bagDuration(bag);
+  ASSERT_GT(duration, 30.0);
+  const std::string all = remapsUnder("stop_go");
+  const std::string imu_only = " --topics /imu/data_raw /imu/mag" + all;
+  const std::string camera_only = " --topics /camera/image_raw /camera/camera_info" + all;
+  const auto part = [&](double from, double to, const std::string& args) {
+    return play(bag, 4.0,
+                "--start " + std::to_string(from * duration) + " --duration " +
+                    std::to_string((to - from) * duration) + args)
+        .get();
+  };
+  EXPECT_EQ(part(0.0, 0.35, all), 0);
+  EXPECT_EQ(part(0.35, 0.5, imu_only), 0);
+  EXPECT_EQ(part(0.5, 0.6, camera_only), 0);
+  ros::WallDuration(3.0).sleep();  // nothing at all for a while
+  EXPECT_EQ(part(0.6, 1.0, all), 0);
+
+  const auto status = waitForStatus(
+      30.0, [](const AlignmentStatus& s) { return s.has_estimate && s.poses_total >= 6; },
+      "/stop_go");
+  ASSERT_TRUE(status) << node.log();
+  EXPECT_GE(status->poses_total, 6u) << node.log();
+  EXPECT_LT(status->poses_total, 12u);  // the holds without camera or IMU gave no pose
+  EXPECT_LT(angleDeg(toMatrix(status->q_cam_imu), R_true), 0.3);
+  const auto R = waitForTf(buffer_, "sg_cam", "sg_imu", 10.0);
+  ASSERT_TRUE(R) << node.log();
+  EXPECT_LT(angleDeg(*R, R_true), 0.3);
+
+  std_srvs::Trigger save;
+  ASSERT_TRUE(ros::service::call("/stop_go/save", save));
+  EXPECT_FALSE(save.response.success);
+  EXPECT_NE(save.response.message.find(blocker), std::string::npos) << save.response.message;
+  EXPECT_NE(save.response.message.find("Not a directory"), std::string::npos)
+      << save.response.message;
+  const auto values = waitForDiagnostics("stop_go", 10.0, [](const auto& v) {
+    return v.count("last save error") && v.at("last save error") != "none";
+  });
+  EXPECT_NE(values.count("last save error") ? values.at("last save error").find("Not a directory")
+                                            : std::string::npos,
+            std::string::npos);
+  EXPECT_GE(countOf(values, "imu gaps"), 1);
+  EXPECT_EQ(test::readTextFile(blocker), "a file where the output's directory should be\n");
+  EXPECT_TRUE(node.alive()) << node.log();
 }
 
 }  // namespace

@@ -291,3 +291,71 @@ TEST(CalibrationPipeline, BadSamplesAreCountedAndDropped) {
 
 }  // namespace
 }  // namespace camera_imu_alignment
+
+namespace camera_imu_alignment {
+namespace {
+
+/// A long run (more poses than the history keeps) at 100 Hz with given camera orientations:
+/// every buffer stays within its cap, totals and indices keep counting, and the estimate is still
+/// the true mounting. This is what lets the nodelet run for days.
+TEST(CalibrationPipeline, MemoryStaysBoundedOverALongRun) {
+  const Eigen::Matrix3d R_cam_imu = expSO3(Eigen::Vector3d(0.3, -0.5, 1.6));
+  const Eigen::Matrix3d R_target_world = expSO3(Eigen::Vector3d(3.0, 0.2, 0.1));
+  PipelineSettings settings;
+  CalibrationPipeline pipeline(
+      parseTargetYaml("target_type: 'checkerboard'\ntargetCols: 8\ntargetRows: 6\n"
+                      "rowSpacingMeters: 0.04\ncolSpacingMeters: 0.04\n",
+                      "test target"),
+      settings);
+  const std::size_t kPoses = CalibrationPipeline::kHistoryLimit + 150;
+  const double dt = 0.01;
+  const Eigen::Vector3d up(0.0, 0.0, 9.81);
+  const Eigen::Vector3d axes[] = {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0),
+                                  Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(1, 1, 0).normalized()};
+  Eigen::Matrix3d R_world_imu = Eigen::Matrix3d::Identity();
+  double t = 1.0;
+  PipelineBufferSizes largest;
+  auto grow = [](std::size_t* biggest, std::size_t now) { *biggest = std::max(*biggest, now); };
+  for (std::size_t pose = 0; pose < kPoses; ++pose) {
+    for (int i = 0; i < 330; ++i, t += dt) {  // 3.3 s at rest, camera at 10 Hz
+      pipeline.addImu({t, Eigen::Vector3d::Zero(), R_world_imu.transpose() * up});
+      if (i % 10 == 5) {
+        CameraFrame frame;
+        frame.stamp_s = t;
+        frame.R_target_cam = R_target_world * R_world_imu * R_cam_imu.transpose();
+        pipeline.addFrame(frame);
+      }
+    }
+    // 0.5 s turning by 0.4 rad about one of four axes (alternating sign: the rig stays near level).
+    const Eigen::Vector3d omega = axes[pose % 4] * (pose % 8 < 4 ? 0.8 : -0.8);
+    for (int i = 0; i < 50; ++i, t += dt) {
+      pipeline.addImu({t, omega, R_world_imu.transpose() * up});
+      R_world_imu = R_world_imu * Eigen::AngleAxisd(omega.norm() * dt, omega.normalized()).matrix();
+    }
+    const PipelineBufferSizes now = pipeline.bufferSizes();
+    grow(&largest.imu, now.imu);
+    grow(&largest.frame_queue, now.frame_queue);
+    grow(&largest.detections, now.detections);
+    grow(&largest.poses, now.poses);
+    grow(&largest.rests, now.rests);
+    grow(&largest.rejected_rests, now.rejected_rests);
+    grow(&largest.window, now.window);
+  }
+  pipeline.finish();
+  EXPECT_EQ(pipeline.posesTotal(), kPoses) << pipeline.rejections().summary();
+  EXPECT_EQ(pipeline.restsTotal(), kPoses);
+  EXPECT_EQ(largest.poses, CalibrationPipeline::kHistoryLimit);
+  EXPECT_EQ(largest.rests, CalibrationPipeline::kHistoryLimit);
+  EXPECT_EQ(pipeline.poses().size(), CalibrationPipeline::kHistoryLimit);
+  EXPECT_EQ(pipeline.poses().back().index, static_cast<int>(kPoses) - 1);
+  EXPECT_EQ(largest.window, settings.window_poses);
+  EXPECT_LE(largest.imu, static_cast<std::size_t>(settings.max_gyro_span_s / dt) + 1);
+  EXPECT_LE(largest.frame_queue, static_cast<std::size_t>(settings.frame_queue_s / 0.1) + 1);
+  EXPECT_LE(largest.detections, static_cast<std::size_t>(settings.max_frames_per_pose));
+  const std::optional<AlignmentResult> result = pipeline.lastResult();
+  ASSERT_TRUE(result);
+  EXPECT_LT(rad2deg(rotationAngle(result->R_cam_imu.transpose() * R_cam_imu)), 1e-3);
+}
+
+}  // namespace
+}  // namespace camera_imu_alignment

@@ -1,6 +1,7 @@
 // CSV readers/writers and the result YAML: formats of CONVENTIONS.md, errors naming file and line.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
@@ -8,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 #include "camera_imu_alignment/csv_io.h"
@@ -359,19 +361,62 @@ TEST(ResultYaml, FailedWritesThrowAndLeaveNoTrace) {
   EXPECT_EQ(entries(), entries_before);
 }
 
+/// Runs `body` as the unprivileged user nobody in a child process when we are root (root ignores
+/// directory permissions), else directly. True when `body` returned true.
+bool asUnprivilegedUser(const std::function<bool()>& body) {
+  if (geteuid() != 0) return body();
+  const pid_t child = fork();
+  if (child == 0) {
+    const bool ok = setgid(65534) == 0 && setuid(65534) == 0 && body();
+    _exit(ok ? 0 : 1);
+  }
+  int status = 0;
+  return child > 0 && waitpid(child, &status, 0) == child && WIFEXITED(status) &&
+         WEXITSTATUS(status) == 0;
+}
+
 TEST(ResultYaml, ReadOnlyDirectoryKeepsThePreviousFile) {
-  if (geteuid() == 0) GTEST_SKIP() << "root ignores directory permissions";
-  const std::string dir = tempDir() + "read_only/";
-  std::filesystem::create_directory(dir);
-  ASSERT_TRUE(std::filesystem::is_directory(dir));
+  // A directory the writer may read but not write, reachable by everyone (not under the 0700
+  // per-process temp dir, so that the unprivileged child gets as far as the write).
+  char pattern[] = "/tmp/cia_read_only_XXXXXX";
+  ASSERT_NE(mkdtemp(pattern), nullptr);
+  const std::string dir = std::string(pattern) + "/";
   const std::string path = dir + "result.yaml";
   const Eigen::Matrix3d before = test::axisAngle(kX, 0.3);
   writeResultYaml(path, knownResult(before), ResultMetadata{});
+  ASSERT_EQ(chmod(path.c_str(), 0644), 0);
   ASSERT_EQ(chmod(dir.c_str(), 0555), 0);
-  EXPECT_THROW(writeResultYaml(path, knownResult(Eigen::Matrix3d::Identity()), ResultMetadata{}),
-               InputError);
+  const bool refused = asUnprivilegedUser([&] {
+    try {
+      writeResultYaml(path, knownResult(Eigen::Matrix3d::Identity()), ResultMetadata{});
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      return what.find("Permission denied") != std::string::npos &&
+             what.find("previous file is unchanged") != std::string::npos;
+    }
+    return false;
+  });
   chmod(dir.c_str(), 0755);
+  EXPECT_TRUE(refused) << "the write into a read-only directory did not fail with a clear error";
   EXPECT_ROTATION_NEAR_DEG(readResultYaml(path).R_cam_imu, before, 1e-9);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ResultYaml, FullDiskKeepsThePreviousFile) {
+  // The temporary file is a link to /dev/full: every write fails with ENOSPC, also for root.
+  const std::string path = tempDir() + "disk_full.yaml";
+  const Eigen::Matrix3d before = test::axisAngle(kX, 0.3);
+  writeResultYaml(path, knownResult(before), ResultMetadata{});
+  std::filesystem::remove(path + ".tmp");
+  std::filesystem::create_symlink("/dev/full", path + ".tmp");
+  try {
+    writeResultYaml(path, knownResult(Eigen::Matrix3d::Identity()), ResultMetadata{});
+    ADD_FAILURE() << "writing to a full disk did not fail";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("No space left"), std::string::npos) << e.what();
+  }
+  EXPECT_ROTATION_NEAR_DEG(readResultYaml(path).R_cam_imu, before, 1e-9);
+  EXPECT_FALSE(std::filesystem::exists(std::filesystem::symlink_status(path + ".tmp")));
 }
 
 TEST(ResultYaml, CorruptSavedFileIsSetAsideAndTheNodeStartsFresh) {

@@ -126,12 +126,25 @@ struct PipelineCallbacks {
   std::function<void(const StationaryPose&)> on_pose;
   std::function<void(const RejectedPose&)> on_pose_rejected;
   std::function<void(const AlignmentResult&)> on_result;
-  /// Every rejected input (reason, detail); the caller throttles what it prints.
-  std::function<void(RejectReason, const std::string&)> on_reject;
+  /// Every rejected input: reason, the stream it came from, and a detail without the stream's
+  /// name ("stamp 12.5 s is earlier than ..."); the caller names the topic and throttles.
+  std::function<void(RejectReason, InputStream, const std::string&)> on_reject;
+};
+
+/// Sizes of everything the pipeline keeps, for diagnostics and the bounded-memory tests. Every
+/// one is capped: the buffers by time (max_gyro_span_s, frame_queue_s), the window by
+/// window_poses, the histories by CalibrationPipeline::kHistoryLimit.
+struct PipelineBufferSizes {
+  std::size_t imu = 0, mag = 0, frame_queue = 0, detections = 0;
+  std::size_t poses = 0, rests = 0, rejected_rests = 0, window = 0;
 };
 
 class CalibrationPipeline {
  public:
+  /// poses(), segments() and rejectedPoses() keep the newest this many entries (a node running
+  /// for days must not grow); the totals count all.
+  static constexpr std::size_t kHistoryLimit = 1000;
+
   /// Throws std::invalid_argument when settings.validate() fails.
   CalibrationPipeline(const TargetDescription& target, const PipelineSettings& settings,
                       PipelineCallbacks callbacks = {});
@@ -142,6 +155,9 @@ class CalibrationPipeline {
   /// Sets or replaces the intrinsics (validated; a bad one is counted and ignored).
   bool setCameraIntrinsics(const CameraIntrinsics& intrinsics);
   void addFrame(const CameraFrame& frame);
+  /// Counts an input refused before it reached the pipeline (a ROS message without a stamp, an
+  /// image that cannot be converted, ...) and reports it through on_reject like its own.
+  void rejectInput(RejectReason reason, InputStream stream, const std::string& detail);
   /// End of data: closes the rest in progress and processes the queued frames.
   void finish();
   /// Solves on the current window (also done automatically after every new pose).
@@ -153,10 +169,15 @@ class CalibrationPipeline {
   void keepNewestPoses(std::size_t count);
   std::size_t windowSize() const;  ///< poses in the solver's window
 
-  const std::vector<StationaryPose>& poses() const;  ///< all poses so far
+  const std::vector<StationaryPose>& poses() const;  ///< the newest kHistoryLimit poses
   RotationPairs windowPairs() const;  ///< the pairs solve() uses (poses in the window)
   const std::vector<RejectedPose>& rejectedPoses() const;
-  const std::vector<StationarySegment>& segments() const;  ///< all IMU rests so far
+  const std::vector<StationarySegment>& segments() const;  ///< the newest kHistoryLimit rests
+  std::size_t posesTotal() const;  ///< poses since the start or the last reset
+  /// Gaps in the IMU stamps longer than max_imu_gap_s (each ends a rest in progress).
+  std::uint64_t imuGaps() const;
+  std::size_t restsTotal() const;  ///< IMU rests (segments) since the start or the last reset
+  PipelineBufferSizes bufferSizes() const;
   const RejectionCounts& rejections() const;
   std::optional<AlignmentResult> lastResult() const;
   /// Counters for progress and diagnostics.

@@ -35,6 +35,7 @@ enum class RejectReason {
   kZeroVector,      ///< accelerometer or magnetometer norm (near) zero
   kStampBackwards,  ///< stamp earlier than the previous sample of the same stream
   kDuplicateStamp,  ///< stamp equal to the previous sample of the same stream
+  kMissingStamp,    ///< header stamp zero: the driver never set it (ROS messages only)
   kMagneticUnits,   ///< field norm far outside 20-70 microtesla (gauss or microtesla sent as T?)
   kBadImage,        ///< empty image, unsupported encoding, size differs from the camera info
   kBadCameraInfo,   ///< zero/non-finite K, D of a wrong length, unknown distortion model
@@ -42,6 +43,12 @@ enum class RejectReason {
   kPoseRejected,    ///< PnP failed, reprojection error too high or ambiguous planar solution
   kCount            ///< number of reasons (not a reason)
 };
+
+/// Which input a rejected item came from; the nodelet names the topic, calibrate_bag the bag topic.
+enum class InputStream { kImu, kMagnetometer, kImage, kCameraInfo, kCameraPose };
+
+/// "imu", "mag", "image", "camera_info", "camera_pose".
+const char* inputStreamName(InputStream stream);
 
 /// Short snake_case name of a reason ("non_finite", "stamp_backwards", ...), for logs and reports.
 const char* rejectReasonName(RejectReason reason);

@@ -17,9 +17,9 @@ enum class FieldUnits {
 
 /// Classifies a field norm (in the message's unit, nominally tesla).
 FieldUnits classifyFieldUnits(double norm, double min_t = 15e-6, double max_t = 100e-6);
-/// Message for a unit problem, naming the source (e.g. the topic): "imu/mag: field norm 0.45
-/// looks like gauss, sensor_msgs/MagneticField is in tesla (set mag_scale ...)".
-std::string describeFieldUnits(FieldUnits units, double norm, const std::string& source);
+/// Message for a unit problem: "field norm 0.45 looks like gauss; sensor_msgs/MagneticField is in
+/// tesla (set mag_scale ...)". The caller names the topic.
+std::string describeFieldUnits(FieldUnits units, double norm);
 
 /// Corrected field = soft_iron * (raw - hard_iron), in tesla, IMU frame.
 struct MagnetometerCalibration {

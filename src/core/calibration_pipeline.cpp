@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 #include <stdexcept>
 
@@ -117,9 +118,15 @@ CalibrationPipeline::Impl::Impl(const TargetDescription& target_, const Pipeline
       disturbance(settings_.disturbance),
       window(settings_.window_poses) {}
 
-void CalibrationPipeline::Impl::reject(RejectReason reason, const std::string& detail) {
+void CalibrationPipeline::Impl::reject(RejectReason reason, InputStream stream,
+                                       const std::string& detail) {
   rejections.add(reason);
-  if (callbacks.on_reject) callbacks.on_reject(reason, detail);
+  if (callbacks.on_reject) callbacks.on_reject(reason, stream, detail);
+}
+
+void CalibrationPipeline::rejectInput(RejectReason reason, InputStream stream,
+                                      const std::string& detail) {
+  impl_->reject(reason, stream, detail);
 }
 
 CalibrationPipeline::CalibrationPipeline(const TargetDescription& target,
@@ -132,19 +139,19 @@ CalibrationPipeline::CalibrationPipeline(const TargetDescription& target,
 
 CalibrationPipeline::~CalibrationPipeline() = default;
 
-bool CalibrationPipeline::Impl::checkStamp(double stamp, double* last, const char* stream) {
+bool CalibrationPipeline::Impl::checkStamp(double stamp, double* last, InputStream stream) {
   Impl* impl = this;
   if (stamp < *last) {
     std::ostringstream out;
-    out << stream << ": stamp " << stamp << " s is earlier than the previous one (" << *last
-        << " s); sample dropped";
-    impl->reject(RejectReason::kStampBackwards, out.str());
+    out << std::setprecision(15) << "stamp " << stamp << " s is earlier than the previous one ("
+        << *last << " s); sample dropped";
+    impl->reject(RejectReason::kStampBackwards, stream, out.str());
     return false;
   }
   if (stamp == *last) {
     std::ostringstream out;
-    out << stream << ": duplicate stamp " << stamp << " s; sample dropped";
-    impl->reject(RejectReason::kDuplicateStamp, out.str());
+    out << std::setprecision(15) << "duplicate stamp " << stamp << " s; sample dropped";
+    impl->reject(RejectReason::kDuplicateStamp, stream, out.str());
     return false;
   }
   *last = stamp;
@@ -154,22 +161,28 @@ bool CalibrationPipeline::Impl::checkStamp(double stamp, double* last, const cha
 void CalibrationPipeline::addImu(const ImuSample& sample) {
   Impl& s = *impl_;
   if (!std::isfinite(sample.stamp_s) || !finite(sample.gyro_rad_s) || !finite(sample.accel_m_s2)) {
-    s.reject(RejectReason::kNonFinite, "imu: NaN or Inf in a sample; sample dropped");
+    s.reject(RejectReason::kNonFinite, InputStream::kImu, "NaN or Inf in a sample; sample dropped");
     return;
   }
   if (sample.accel_m_s2.norm() < 1e-6) {
-    s.reject(RejectReason::kZeroVector, "imu: zero accelerometer vector; sample dropped");
+    s.reject(RejectReason::kZeroVector, InputStream::kImu,
+             "zero accelerometer vector; sample dropped");
     return;
   }
   if (sample.q_world_imu && !(std::abs(sample.q_world_imu->norm() - 1.0) < 1e-3)) {
     ImuSample without = sample;  // the rates are fine: keep them, drop the orientation
     without.q_world_imu.reset();
-    s.reject(RejectReason::kNonFinite, "imu: orientation is not a unit quaternion; ignored");
+    s.reject(RejectReason::kNonFinite, InputStream::kImu,
+             "orientation is not a unit quaternion; orientation ignored, rates used");
     addImu(without);
     return;
   }
-  if (!s.checkStamp(sample.stamp_s, &s.last_imu_stamp, "imu")) return;
+  const double previous_s = s.last_imu_stamp;
+  if (!s.checkStamp(sample.stamp_s, &s.last_imu_stamp, InputStream::kImu)) return;
   ++s.num_imu;
+  if (std::isfinite(previous_s) && sample.stamp_s - previous_s > s.settings.stationary.max_gap_s) {
+    ++s.imu_gaps;
+  }
   // Frames are judged with the rest state before this sample: a rest that ends with this sample
   // still counts for frames taken inside it.
   s.processFrames(false);
@@ -185,20 +198,23 @@ void CalibrationPipeline::addImu(const ImuSample& sample) {
 void CalibrationPipeline::addMagnetic(const MagneticSample& sample) {
   Impl& s = *impl_;
   if (!std::isfinite(sample.stamp_s) || !finite(sample.field_t)) {
-    s.reject(RejectReason::kNonFinite, "mag: NaN or Inf in a sample; sample dropped");
+    s.reject(RejectReason::kNonFinite, InputStream::kMagnetometer,
+             "NaN or Inf in a sample; sample dropped");
     return;
   }
   if (sample.field_t.norm() == 0.0) {
-    s.reject(RejectReason::kZeroVector, "mag: zero field vector; sample dropped");
+    s.reject(RejectReason::kZeroVector, InputStream::kMagnetometer,
+             "zero field vector; sample dropped");
     return;
   }
-  if (!s.checkStamp(sample.stamp_s, &s.last_mag_stamp, "mag")) return;
+  if (!s.checkStamp(sample.stamp_s, &s.last_mag_stamp, InputStream::kMagnetometer)) return;
   MagneticSample corrected = sample;
   corrected.field_t = s.settings.magnetometer.apply(sample.field_t);
   const double norm = corrected.field_t.norm();
   const FieldUnits units = classifyFieldUnits(norm);
   if (units != FieldUnits::kTesla) {
-    s.reject(RejectReason::kMagneticUnits, describeFieldUnits(units, norm, "mag"));
+    s.reject(RejectReason::kMagneticUnits, InputStream::kMagnetometer,
+             describeFieldUnits(units, norm));
     return;
   }
   ++s.num_mag;
@@ -212,7 +228,7 @@ void CalibrationPipeline::addMagnetic(const MagneticSample& sample) {
 bool CalibrationPipeline::setCameraIntrinsics(const CameraIntrinsics& intrinsics) {
   const std::string error = intrinsics.validate();
   if (!error.empty()) {
-    impl_->reject(RejectReason::kBadCameraInfo, "camera_info: " + error + "; ignored");
+    impl_->reject(RejectReason::kBadCameraInfo, InputStream::kCameraInfo, error + "; ignored");
     return false;
   }
   impl_->intrinsics = intrinsics;
@@ -221,20 +237,21 @@ bool CalibrationPipeline::setCameraIntrinsics(const CameraIntrinsics& intrinsics
 
 void CalibrationPipeline::addFrame(const CameraFrame& frame) {
   Impl& s = *impl_;
+  const InputStream stream = frame.R_target_cam ? InputStream::kCameraPose : InputStream::kImage;
   if (!std::isfinite(frame.stamp_s)) {
-    s.reject(RejectReason::kNonFinite, "image: stamp is not finite; frame dropped");
+    s.reject(RejectReason::kNonFinite, stream, "stamp is not finite; frame dropped");
     return;
   }
   if (frame.R_target_cam) {
     if (!isRotationMatrix(*frame.R_target_cam, 1e-6)) {
-      s.reject(RejectReason::kNonFinite, "camera pose: not a finite unit rotation; dropped");
+      s.reject(RejectReason::kNonFinite, stream, "not a finite unit rotation; dropped");
       return;
     }
   } else if (frame.mono8.empty() || frame.mono8.type() != CV_8UC1) {
-    s.reject(RejectReason::kBadImage, "image: empty or not mono8 after conversion; frame dropped");
+    s.reject(RejectReason::kBadImage, stream, "empty or not mono8 after conversion; frame dropped");
     return;
   }
-  if (!s.checkStamp(frame.stamp_s, &s.last_frame_stamp, "image")) return;
+  if (!s.checkStamp(frame.stamp_s, &s.last_frame_stamp, stream)) return;
   ++s.num_frames;
   s.frame_queue.push_back(frame);
   // Without IMU data frames cannot be judged: keep a bounded backlog only.
@@ -279,10 +296,9 @@ void CalibrationPipeline::Impl::processFrame(const CameraFrame& frame) {
   }
   if (frame.mono8.cols != intrinsics->width || frame.mono8.rows != intrinsics->height) {
     std::ostringstream out;
-    out << "image: " << frame.mono8.cols << "x" << frame.mono8.rows
-        << " differs from the camera info's " << intrinsics->width << "x" << intrinsics->height
-        << "; frame dropped";
-    reject(RejectReason::kBadImage, out.str());
+    out << frame.mono8.cols << "x" << frame.mono8.rows << " differs from the camera info's "
+        << intrinsics->width << "x" << intrinsics->height << "; frame dropped";
+    reject(RejectReason::kBadImage, InputStream::kImage, out.str());
     return;
   }
   last_detection_stamp = frame.stamp_s;
@@ -292,13 +308,14 @@ void CalibrationPipeline::Impl::processFrame(const CameraFrame& frame) {
   if (!detector.detect(frame.mono8, &observation, hint)) {
     std::ostringstream out;
     out << "image at " << frame.stamp_s << " s (at rest): " << target.describe() << " not found";
-    reject(RejectReason::kTargetNotFound, out.str());
+    reject(RejectReason::kTargetNotFound, InputStream::kImage, out.str());
     return;
   }
   std::string why;
   const auto pose = estimateCameraPose(observation, target, *intrinsics, settings.pose, &why);
   if (!pose) {
-    reject(RejectReason::kPoseRejected, "image at " + std::to_string(frame.stamp_s) + " s: " + why);
+    reject(RejectReason::kPoseRejected, InputStream::kImage,
+           "image at " + std::to_string(frame.stamp_s) + " s: " + why);
     return;
   }
   detections.push_back({frame.stamp_s, *pose});
@@ -314,7 +331,7 @@ AlignmentResult CalibrationPipeline::solve() const { return impl_->solve(); }
 void CalibrationPipeline::reset(bool clear_counts) {
   const RejectionCounts counts = impl_->rejections;
   const std::uint64_t n_imu = impl_->num_imu, n_mag = impl_->num_mag, n_frames = impl_->num_frames,
-                      n_detected = impl_->num_detected;
+                      n_detected = impl_->num_detected, n_gaps = impl_->imu_gaps;
   const std::optional<CameraIntrinsics> intrinsics = impl_->intrinsics;
   impl_ = std::make_unique<Impl>(impl_->target, impl_->settings, impl_->callbacks);
   impl_->intrinsics = intrinsics;  // configuration, not data: kept
@@ -324,6 +341,7 @@ void CalibrationPipeline::reset(bool clear_counts) {
     impl_->num_mag = n_mag;
     impl_->num_frames = n_frames;
     impl_->num_detected = n_detected;
+    impl_->imu_gaps = n_gaps;
   }
 }
 
@@ -339,6 +357,23 @@ const std::vector<StationarySegment>& CalibrationPipeline::segments() const {
   return impl_->segments;
 }
 const RejectionCounts& CalibrationPipeline::rejections() const { return impl_->rejections; }
+std::uint64_t CalibrationPipeline::imuGaps() const { return impl_->imu_gaps; }
+std::size_t CalibrationPipeline::posesTotal() const { return impl_->poses_total; }
+std::size_t CalibrationPipeline::restsTotal() const { return impl_->rests_total; }
+
+PipelineBufferSizes CalibrationPipeline::bufferSizes() const {
+  const Impl& s = *impl_;
+  PipelineBufferSizes sizes;
+  sizes.imu = s.imu_buffer.size();
+  sizes.mag = s.mag_buffer.size();
+  sizes.frame_queue = s.frame_queue.size();
+  sizes.detections = s.detections.size();
+  sizes.poses = s.poses.size();
+  sizes.rests = s.segments.size();
+  sizes.rejected_rests = s.rejected.size();
+  sizes.window = s.window.size();
+  return sizes;
+}
 std::optional<AlignmentResult> CalibrationPipeline::lastResult() const {
   return impl_->last_result;
 }

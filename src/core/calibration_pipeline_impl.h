@@ -61,9 +61,12 @@ struct CalibrationPipeline::Impl {
   PoseWindow window;
   std::optional<AlignmentResult> last_result;
 
-  void reject(RejectReason reason, const std::string& detail);
+  std::size_t poses_total = 0, rests_total = 0;
+  std::uint64_t imu_gaps = 0;  ///< IMU stamp gaps longer than settings.stationary.max_gap_s
+
+  void reject(RejectReason reason, InputStream stream, const std::string& detail);
   /// Stamp order check shared by the three streams; false (counted) when rejected.
-  bool checkStamp(double stamp, double* last, const char* stream);
+  bool checkStamp(double stamp, double* last, InputStream stream);
   /// Processes queued frames whose rest/motion status the IMU has settled.
   void processFrames(bool flush);
   void processFrame(const CameraFrame& frame);

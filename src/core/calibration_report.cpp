@@ -59,26 +59,6 @@ std::string statusName(SolveStatus status) {
   return "unknown";
 }
 
-/// Snake_case names of the RejectReason values, in enum order (as rejectReasonName() spells them).
-const char* const kReasonLabels[] = {"non_finite",      "zero_vector",      "stamp_backwards",
-                                     "duplicate_stamp", "magnetic_units",   "bad_image",
-                                     "bad_camera_info", "target_not_found", "pose_rejected"};
-static_assert(sizeof(kReasonLabels) / sizeof(kReasonLabels[0]) ==
-                  static_cast<std::size_t>(RejectReason::kCount),
-              "one label per RejectReason");
-
-/// "non_finite: 3, bad_image: 1", or "none".
-std::string rejectionText(const RejectionCounts& counts) {
-  std::string text;
-  for (int i = 0; i < static_cast<int>(RejectReason::kCount); ++i) {
-    const auto reason = static_cast<RejectReason>(i);
-    if (counts.count(reason) == 0) continue;
-    if (!text.empty()) text += ", ";
-    text += std::string(kReasonLabels[i]) + ": " + std::to_string(counts.count(reason));
-  }
-  return text.empty() ? "none" : text;
-}
-
 /// q_cam_imu with w >= 0 (q and -q are the same rotation).
 Eigen::Quaterniond canonicalQuaternion(const Eigen::Matrix3d& R) {
   Eigen::Quaterniond q(R);
@@ -189,7 +169,7 @@ void writePoses(std::ostream& out, const ReportInput& in) {
         << fixed(r.end_s - in.start_s, 2)
         << " s (from start): " << (r.reason.empty() ? "(no reason given)" : r.reason) << "\n";
   }
-  out << "inputs rejected: " << rejectionText(in.rejections) << "\n";
+  out << "inputs rejected: " << in.rejections.summary() << "\n";
 }
 
 // --- Drawing helpers (BGR colours, pixel coordinates)
@@ -533,9 +513,8 @@ void drawEstimateText(cv::Mat& img, const cv::Rect& panel, const ReportInput& in
            fixed(q.observability, 3) + ", weakest excitation " +
            fixed(q.weakest_excitation_deg, 2) + " deg)" + advice,
        q.observable ? kBlack : kRed);
-  line("poses used: " + std::to_string(in.poses.size()) +
-           "   rests rejected: " + std::to_string(in.rejected.size()) +
-           "   inputs rejected: " + rejectionText(in.rejections),
+  line("poses used: " + std::to_string(in.poses.size()) + "   rests rejected: " +
+           std::to_string(in.rejected.size()) + "   inputs rejected: " + in.rejections.summary(),
        kBlack);
   std::string rests;
   for (std::size_t i = 0; i < in.rejected.size(); ++i) {

@@ -15,6 +15,8 @@ const char* rejectReasonName(RejectReason reason) {
       return "stamp_backwards";
     case RejectReason::kDuplicateStamp:
       return "duplicate_stamp";
+    case RejectReason::kMissingStamp:
+      return "missing_stamp";
     case RejectReason::kMagneticUnits:
       return "magnetic_units";
     case RejectReason::kBadImage:
@@ -27,6 +29,22 @@ const char* rejectReasonName(RejectReason reason) {
       return "pose_rejected";
     case RejectReason::kCount:
       break;
+  }
+  return "unknown";
+}
+
+const char* inputStreamName(InputStream stream) {
+  switch (stream) {
+    case InputStream::kImu:
+      return "imu";
+    case InputStream::kMagnetometer:
+      return "mag";
+    case InputStream::kImage:
+      return "image";
+    case InputStream::kCameraInfo:
+      return "camera_info";
+    case InputStream::kCameraPose:
+      return "camera_pose";
   }
   return "unknown";
 }

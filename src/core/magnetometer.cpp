@@ -17,9 +17,9 @@ FieldUnits classifyFieldUnits(double norm, double min_t, double max_t) {
   return FieldUnits::kOutOfRange;
 }
 
-std::string describeFieldUnits(FieldUnits units, double norm, const std::string& source) {
+std::string describeFieldUnits(FieldUnits units, double norm) {
   std::ostringstream out;
-  out << source << ": field norm " << norm;
+  out << "field norm " << norm;
   switch (units) {
     case FieldUnits::kTesla:
       out << " T is plausible";

@@ -102,12 +102,20 @@ Eigen::Matrix3d resolveSymmetry(const Eigen::Matrix3d& R_target_cam,
   return readings[order[0]];
 }
 
+/// Appends, dropping the oldest entry beyond CalibrationPipeline::kHistoryLimit.
+template <typename T>
+void pushBounded(std::vector<T>* history, const T& item) {
+  if (history->size() >= CalibrationPipeline::kHistoryLimit) history->erase(history->begin());
+  history->push_back(item);
+}
+
 }  // namespace
 
 void CalibrationPipeline::Impl::onSegment(const StationarySegment& segment) {
-  segments.push_back(segment);
+  pushBounded(&segments, segment);
+  ++rests_total;
   StationaryPose pose;
-  pose.index = static_cast<int>(poses.size());
+  pose.index = static_cast<int>(poses_total);
   pose.start_s = segment.start_s;
   pose.end_s = segment.end_s;
   pose.gyro_bias_rad_s = segment.gyro_bias_rad_s;
@@ -235,12 +243,13 @@ void CalibrationPipeline::Impl::onSegment(const StationarySegment& segment) {
     }
   }
   if (!rejection.reason.empty()) {
-    rejected.push_back(rejection);
+    pushBounded(&rejected, rejection);
     if (callbacks.on_pose_rejected) callbacks.on_pose_rejected(rejection);
     return;
   }
 
-  poses.push_back(pose);
+  pushBounded(&poses, pose);
+  ++poses_total;
   PoseOrientation orientation;
   orientation.stamp_s = 0.5 * (pose.start_s + pose.end_s);
   orientation.R_target_cam = pose.R_target_cam;

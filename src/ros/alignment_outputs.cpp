@@ -39,22 +39,27 @@ void AlignmentWrapper::Impl::advertise() {
   reset_srv = pnh.advertiseService("reset", &Impl::onReset, this);
   save_srv = pnh.advertiseService("save", &Impl::onSave, this);
   capture_srv = pnh.advertiseService("capture_pose", &Impl::onCapturePose, this);
-  status_timer = pnh.createTimer(ros::Duration(settings.status_period_s), [this](const auto&) {
-    publishStatus();
-    diagnostics.update();
-  });
+  // Wall time: status and diagnostics keep coming while a bag is paused or no clock runs (they
+  // show that the node is alive), and not ten times as often when a bag plays at 10x.
+  status_timer =
+      pnh.createWallTimer(ros::WallDuration(settings.status_period_s), [this](const auto&) {
+        publishStatus();
+        diagnostics.force_update();
+      });
   diagnostics.setHardwareID("camera_imu_alignment");
   diagnostics.add("calibration", this, &Impl::diagnose);
 }
 
 std::string AlignmentWrapper::Impl::cameraFrame() const {
   if (!settings.camera_frame.empty()) return settings.camera_frame;
-  return image_frame.empty() ? "camera_optical_frame" : image_frame;
+  if (!input->cameraFrame().empty()) return input->cameraFrame();
+  return saved_camera_frame.empty() ? "camera_optical_frame" : saved_camera_frame;
 }
 
 std::string AlignmentWrapper::Impl::imuFrame() const {
   if (!settings.imu_frame.empty()) return settings.imu_frame;
-  return imu_msg_frame.empty() ? "imu_link" : imu_msg_frame;
+  if (!input->imuFrame().empty()) return input->imuFrame();
+  return saved_imu_frame.empty() ? "imu_link" : saved_imu_frame;
 }
 
 void AlignmentWrapper::Impl::onResult(const AlignmentResult& result) {
@@ -81,8 +86,13 @@ void AlignmentWrapper::Impl::onResult(const AlignmentResult& result) {
   state_message = result.message;
   broadcast(result.R_cam_imu, result.quality.std_dev_deg.maxCoeff());
   std::string error;
-  if (!settings.output_file.empty() && !save(result, &error)) {
-    ROS_ERROR_THROTTLE(10.0, "camera_imu_alignment: %s", error.c_str());
+  if (!settings.output_file.empty()) {
+    if (save(result, &error)) {
+      save_error.clear();
+    } else {
+      save_error = error;
+      ROS_ERROR_THROTTLE(10.0, "camera_imu_alignment: %s", error.c_str());
+    }
   }
   publishStatus();
 }
@@ -127,8 +137,8 @@ void AlignmentWrapper::Impl::loadSaved() {
   if (!warning.empty())
     ROS_WARN("camera_imu_alignment: saved calibration not loaded: %s", warning.c_str());
   if (!stored) return;
-  if (settings.camera_frame.empty()) image_frame = stored->camera_frame;
-  if (settings.imu_frame.empty()) imu_msg_frame = stored->imu_frame;
+  saved_camera_frame = stored->camera_frame;
+  saved_imu_frame = stored->imu_frame;
   broadcast(stored->R_cam_imu, std::numeric_limits<double>::infinity());
   state = "calibrated";
   state_message = "calibration loaded from " + settings.output_file;
@@ -137,7 +147,7 @@ void AlignmentWrapper::Impl::loadSaved() {
 
 void AlignmentWrapper::Impl::publishStatus() {
   AlignmentStatus s;
-  s.header.stamp = last_stamp_s > 0.0 ? ros::Time(last_stamp_s) : ros::Time::now();
+  s.header.stamp = clock.newest() > 0.0 ? ros::Time(clock.newest()) : ros::Time::now();
   s.header.frame_id = cameraFrame();
   if (state == "waiting_for_data") {
     if (pipeline->imuSamples() == 0) {
@@ -153,8 +163,8 @@ void AlignmentWrapper::Impl::publishStatus() {
   s.state = state;
   s.message = state_message;
   s.poses_in_window = static_cast<std::uint32_t>(pipeline->windowSize());
-  s.poses_total = static_cast<std::uint32_t>(pipeline->poses().size());
-  s.rests_total = static_cast<std::uint32_t>(pipeline->segments().size());
+  s.poses_total = static_cast<std::uint32_t>(pipeline->posesTotal());
+  s.rests_total = static_cast<std::uint32_t>(pipeline->restsTotal());
   const AlignmentResult* r = last_result ? &*last_result : nullptr;
   s.q_cam_imu.w = 1.0;
   if (r) {
@@ -183,9 +193,13 @@ void AlignmentWrapper::Impl::publishStatus() {
 void AlignmentWrapper::Impl::publishPoses() {
   // Camera orientations at the poses, in the target frame (rviz: fixed frame = the target).
   geometry_msgs::PoseArray out;
-  out.header.stamp = ros::Time(last_stamp_s > 0.0 ? last_stamp_s : 0.0);
+  out.header.stamp = ros::Time(std::max(clock.newest(), 0.0));
   out.header.frame_id = "calibration_target";
-  for (const StationaryPose& p : pipeline->poses()) {
+  // The poses in the sliding window: the newest windowSize() of the history.
+  const std::vector<StationaryPose>& history = pipeline->poses();
+  const std::size_t first = history.size() - std::min(history.size(), pipeline->windowSize());
+  for (std::size_t i = first; i < history.size(); ++i) {
+    const StationaryPose& p = history[i];
     geometry_msgs::Pose pose;
     pose.position.x = p.p_target_cam.x();
     pose.position.y = p.p_target_cam.y();
@@ -296,6 +310,7 @@ bool AlignmentWrapper::Impl::onSave(std_srvs::Trigger::Request&, std_srvs::Trigg
     std::string error;
     res.success = save(*accepted_result, &error);
     res.message = res.success ? "saved to " + settings.output_file : error;
+    save_error = error;
   }
   return true;
 }
@@ -319,7 +334,12 @@ void AlignmentWrapper::Impl::diagnose(diagnostic_updater::DiagnosticStatusWrappe
                               : state == "not_observable" ? DiagnosticStatus::WARN
                               : state == "recalibrating"  ? DiagnosticStatus::WARN
                                                           : DiagnosticStatus::OK;
-  status.summary(level, state + ": " + state_message);
+  if (save_error.empty()) {
+    status.summary(level, state + ": " + state_message);
+  } else {
+    status.summary(DiagnosticStatus::WARN, state + ": " + state_message + "; " + save_error);
+  }
+  status.add("last save error", save_error.empty() ? "none" : save_error);
   const double elapsed = std::max(1e-3, (ros::WallTime::now() - last_diagnostics).toSec());
   last_diagnostics = ros::WallTime::now();
   status.add("imu rate (Hz)", imu_count / elapsed);
@@ -331,7 +351,14 @@ void AlignmentWrapper::Impl::diagnose(diagnostic_updater::DiagnosticStatusWrappe
   status.add("frames", pipeline->frames());
   status.add("frames detected", pipeline->framesDetected());
   status.add("poses in window", pipeline->windowSize());
-  status.add("rejected inputs", pipeline->rejections().summary());
+  status.add("imu gaps", pipeline->imuGaps());
+  // One key per reason, zeros included, so that monitors can track each.
+  const RejectionCounts& rejections = pipeline->rejections();
+  status.add("rejected inputs", rejections.summary());
+  for (int i = 0; i < static_cast<int>(RejectReason::kCount); ++i) {
+    const auto reason = static_cast<RejectReason>(i);
+    status.add(std::string("rejected ") + rejectReasonName(reason), rejections.count(reason));
+  }
 }
 
 }  // namespace camera_imu_alignment

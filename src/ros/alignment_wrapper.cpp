@@ -25,8 +25,13 @@ AlignmentWrapper::Impl::Impl(ros::NodeHandle nh_, ros::NodeHandle private_nh)
   callbacks.on_pose = [this](const StationaryPose& p) { onPose(p); };
   callbacks.on_pose_rejected = [this](const RejectedPose& r) { onPoseRejected(r); };
   callbacks.on_result = [this](const AlignmentResult& r) { onResult(r); };
-  callbacks.on_reject = [this](RejectReason reason, const std::string& d) { onReject(reason, d); };
+  callbacks.on_reject = [this](RejectReason reason, InputStream stream, const std::string& d) {
+    onReject(reason, stream, d);
+  };
   pipeline = std::make_unique<CalibrationPipeline>(target, pipeline_settings, callbacks);
+  input = std::make_unique<MessageInput>(pipeline.get(), [](const std::string& notice) {
+    ROS_WARN("camera_imu_alignment: %s", notice.c_str());
+  });
   debug_detector = std::make_unique<TargetDetector>(target, pipeline_settings.detector);
   ROS_INFO_STREAM("camera_imu_alignment: target " << target.describe() << " from "
                                                   << settings.target_file);
@@ -44,29 +49,33 @@ AlignmentWrapper::Impl::Impl(ros::NodeHandle nh_, ros::NodeHandle private_nh)
                   << camera_sub.getTopic() << " (+ " << camera_sub.getInfoTopic() << ")");
 }
 
-bool AlignmentWrapper::Impl::acceptStamp(const ros::Time& stamp, const char* topic) {
-  const double t = stamp.toSec();
-  if (t <= 0.0) {
-    ROS_WARN_THROTTLE(5.0, "camera_imu_alignment: %s: message without a stamp dropped", topic);
-    return false;
+std::string AlignmentWrapper::Impl::topicOf(InputStream stream) const {
+  switch (stream) {
+    case InputStream::kImu:
+      return imu_sub.getTopic();
+    case InputStream::kMagnetometer:
+      return mag_sub.getTopic();
+    case InputStream::kImage:
+      return camera_sub.getTopic();
+    case InputStream::kCameraInfo:
+      return camera_sub.getInfoTopic();
+    case InputStream::kCameraPose:
+      return camera_pose_sub.getTopic();
   }
-  // Per topic: a camera's stamps may lag the IMU's by its latency; only a topic going back on
-  // itself is a jump.
-  double& last = last_stamp_by_topic[topic];
-  if (last > 0.0 && t < last - 1.0) {
+  return inputStreamName(stream);
+}
+
+bool AlignmentWrapper::Impl::acceptStamp(const std_msgs::Header& header, InputStream stream) {
+  if (!input->checkStamp(header, stream)) return false;
+  const double jump_s = clock.update(inputStreamName(stream), header.stamp.toSec());
+  if (jump_s > 0.0) {
     ROS_WARN(
         "camera_imu_alignment: %s: time jumped back by %.1f s (bag loop or restarted "
         "clock): buffers reset, the broadcast calibration is kept",
-        topic, last - t);
+        topicOf(stream).c_str(), jump_s);
     pipeline->reset();
     inconsistent_poses = 0;
-    last_stamp_by_topic.clear();
-    last_stamp_by_topic[topic] = t;
-    last_stamp_s = t;
-    return true;
   }
-  last = std::max(last, t);
-  last_stamp_s = std::max(last_stamp_s, t);
   return true;
 }
 
@@ -79,79 +88,80 @@ void AlignmentWrapper::Impl::applyPendingReset() {
 void AlignmentWrapper::Impl::checkStale() {
   if (input_stopped || (ros::WallTime::now() - last_imu_wall).toSec() < 2.0) return;
   input_stopped = true;
-  ROS_INFO("camera_imu_alignment: no IMU data for 2 s: closing the rest in progress");
+  ROS_INFO("camera_imu_alignment: no IMU data for 2 s on %s: closing the rest in progress",
+           imu_sub.getTopic().c_str());
   pipeline->finish();
   applyPendingReset();
   publishStatus();
 }
 
 void AlignmentWrapper::Impl::onImu(const sensor_msgs::ImuConstPtr& msg) {
-  if (!acceptStamp(msg->header.stamp, "imu")) return;
-  imu_msg_frame = msg->header.frame_id;
+  if (!acceptStamp(msg->header, InputStream::kImu)) return;
   last_imu_wall = ros::WallTime::now();
   input_stopped = false;
   ++imu_count;
-  pipeline->addImu(toImuSample(*msg));
+  input->addImu(*msg);
+  if (pipeline->imuGaps() != imu_gaps_warned) {  // differs also after a reset clearing counts
+    imu_gaps_warned = pipeline->imuGaps();
+    if (imu_gaps_warned > 0) {
+      ROS_WARN_THROTTLE(5.0,
+                        "camera_imu_alignment: %s: gap in the IMU data (more than max_imu_gap_s = "
+                        "%.2f s; %lu so far): a rest in progress ended there",
+                        imu_sub.getTopic().c_str(), pipeline_settings.stationary.max_gap_s,
+                        static_cast<unsigned long>(imu_gaps_warned));
+    }
+  }
   applyPendingReset();
 }
 
 void AlignmentWrapper::Impl::onMag(const sensor_msgs::MagneticFieldConstPtr& msg) {
-  if (!acceptStamp(msg->header.stamp, "imu/mag")) return;
+  if (!acceptStamp(msg->header, InputStream::kMagnetometer)) return;
   ++mag_count;
-  pipeline->addMagnetic(toMagneticSample(*msg));
+  if (input->needsMagnetometerRotation()) lookUpMagnetometerRotation();
+  input->addMagnetic(*msg);
   applyPendingReset();
+}
+
+void AlignmentWrapper::Impl::lookUpMagnetometerRotation() {
+  if ((ros::WallTime::now() - last_mag_lookup).toSec() < 1.0) return;
+  last_mag_lookup = ros::WallTime::now();
+  if (!tf_buffer) {
+    tf_buffer = std::make_unique<tf2_ros::Buffer>();
+    tf_listener = std::make_unique<tf2_ros::TransformListener>(*tf_buffer, nh);
+    return;  // give the listener a moment to receive /tf_static
+  }
+  try {
+    const geometry_msgs::TransformStamped t =
+        tf_buffer->lookupTransform(input->imuFrame(), input->magFrame(), ros::Time(0));
+    const auto& q = t.transform.rotation;
+    const Eigen::Quaterniond q_imu_mag(q.w, q.x, q.y, q.z);
+    if (!std::isfinite(q_imu_mag.norm()) || std::abs(q_imu_mag.norm() - 1.0) > 1e-3) return;
+    input->setMagnetometerRotation(q_imu_mag.normalized().toRotationMatrix());
+    ROS_INFO("camera_imu_alignment: magnetometer field rotated from '%s' into '%s' (tf)",
+             input->magFrame().c_str(), input->imuFrame().c_str());
+  } catch (const tf2::TransformException&) {
+    // Not (yet) known: the axes are taken to be the IMU's (MessageInput said so once).
+  }
 }
 
 void AlignmentWrapper::Impl::onImage(const sensor_msgs::ImageConstPtr& image,
                                      const sensor_msgs::CameraInfoConstPtr& info) {
-  if (!acceptStamp(image->header.stamp, "camera")) return;
-  image_frame = image->header.frame_id;
+  if (!acceptStamp(image->header, InputStream::kImage)) return;
   ++image_count;
-  if (info->K != last_info.K || info->D != last_info.D || info->width != last_info.width ||
-      info->height != last_info.height || info->distortion_model != last_info.distortion_model) {
-    CameraIntrinsics intrinsics;
-    std::string error;
-    if (!toCameraIntrinsics(*info, &intrinsics, &error)) {
-      ROS_WARN_THROTTLE(5.0, "camera_imu_alignment: %s: unusable camera info: %s",
-                        camera_sub.getInfoTopic().c_str(), error.c_str());
-      return;
-    }
-    if (pipeline->setCameraIntrinsics(intrinsics)) last_info = *info;
-  }
+  if (!input->setCameraInfo(*info)) return;
   const bool wanted = !settings.manual_capture || capture_armed;  // manual: poses only when asked
-  if (!wanted && debug_pub.getNumSubscribers() == 0) return;
+  const bool debug = debug_pub.getNumSubscribers() > 0;
+  if (!wanted && !debug) return;
   cv::Mat mono8;
-  std::string error;
-  if (!toMono8(*image, &mono8, &error)) {
-    ROS_WARN_THROTTLE(5.0, "camera_imu_alignment: %s: %s", camera_sub.getTopic().c_str(),
-                      error.c_str());
-    return;
-  }
-  if (wanted) {
-    pipeline->addFrame({image->header.stamp.toSec(), mono8});
-    applyPendingReset();
-  }
-  publishDebugImage(mono8, image->header);
+  if (!input->addImage(*image, wanted, &mono8)) return;
+  if (wanted) applyPendingReset();
+  if (debug) publishDebugImage(mono8, image->header);
 }
 
 void AlignmentWrapper::Impl::onCameraPose(const geometry_msgs::PoseStampedConstPtr& msg) {
-  if (!acceptStamp(msg->header.stamp, "camera_pose")) return;
-  if (image_frame.empty()) image_frame = msg->header.frame_id;  // until an image names the camera
+  if (!acceptStamp(msg->header, InputStream::kCameraPose)) return;
   ++image_count;
-  const auto& q = msg->pose.orientation;
-  const double norm = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
-  if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-3) {
-    ROS_WARN_THROTTLE(5.0,
-                      "camera_imu_alignment: %s: orientation is not a unit quaternion "
-                      "(norm %g); pose dropped",
-                      camera_pose_sub.getTopic().c_str(), norm);
-    return;
-  }
-  if (settings.manual_capture && !capture_armed) return;
-  CameraFrame frame;
-  frame.stamp_s = msg->header.stamp.toSec();
-  frame.R_target_cam = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized().toRotationMatrix();
-  pipeline->addFrame(frame);
+  input->addCameraPose(*msg, !settings.manual_capture || capture_armed);
   applyPendingReset();
 }
 
@@ -201,8 +211,21 @@ void AlignmentWrapper::Impl::onPoseRejected(const RejectedPose& rejected) {
                     rejected.end_s, rejected.reason.c_str());
 }
 
-void AlignmentWrapper::Impl::onReject(RejectReason reason, const std::string& detail) {
-  ROS_WARN_THROTTLE(5.0, "camera_imu_alignment: %s: %s", rejectReasonName(reason), detail.c_str());
+void AlignmentWrapper::Impl::onReject(RejectReason reason, InputStream stream,
+                                      const std::string& detail) {
+  const ros::WallTime now = ros::WallTime::now();
+  ros::WallTime& last = last_reject_warning[{stream, reason}];
+  std::uint64_t& unwarned = unwarned_rejects[{stream, reason}];
+  if (!last.isZero() && (now - last).toSec() < 5.0) {
+    ++unwarned;
+    return;
+  }
+  last = now;
+  const std::string more =
+      unwarned > 0 ? " (+" + std::to_string(unwarned) + " more since the last such warning)" : "";
+  unwarned = 0;
+  ROS_WARN("camera_imu_alignment: %s: rejected (%s): %s%s", topicOf(stream).c_str(),
+           rejectReasonName(reason), detail.c_str(), more.c_str());
 }
 
 }  // namespace camera_imu_alignment

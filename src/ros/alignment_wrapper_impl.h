@@ -11,8 +11,10 @@
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/MagneticField.h>
 #include <std_srvs/Trigger.h>
+#include <tf2_ros/buffer.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_broadcaster.h>
+#include <tf2_ros/transform_listener.h>
 
 #include <map>
 #include <memory>
@@ -22,6 +24,8 @@
 #include "camera_imu_alignment/calibration_pipeline.h"
 #include "camera_imu_alignment/ros/alignment_wrapper.h"
 #include "camera_imu_alignment/ros/broadcast_gate.h"
+#include "camera_imu_alignment/ros/clock_jump.h"
+#include "camera_imu_alignment/ros/message_input.h"
 #include "camera_imu_alignment/ros/wrapper_settings.h"
 #include "camera_imu_alignment/target_detector.h"
 
@@ -39,15 +43,20 @@ struct AlignmentWrapper::Impl {
   image_transport::ImageTransport transport;
   ros::Subscriber imu_sub, mag_sub, camera_pose_sub;
   image_transport::CameraSubscriber camera_sub;
-  std::string image_frame, imu_msg_frame;             ///< frame_ids seen on the inputs
-  sensor_msgs::CameraInfo last_info;                  ///< the intrinsics in use
-  double last_stamp_s = -1.0;                         ///< newest input stamp (status)
-  std::map<std::string, double> last_stamp_by_topic;  ///< newest stamp per topic (clock jumps)
-  bool reset_requested = false;                       ///< applied after the pipeline call returns
-  bool capture_armed = false;   ///< manual_capture: ~capture_pose called for this rest
-  ros::WallTime last_imu_wall;  ///< receipt time of the newest IMU message
-  bool input_stopped = true;    ///< no IMU for a while: the rest in progress was closed
+  std::unique_ptr<MessageInput> input;  ///< the checks and conversions calibrate_bag uses too
+  ClockJumpDetector clock;              ///< bag loops, restarted clocks
+  bool reset_requested = false;         ///< applied after the pipeline call returns
+  bool capture_armed = false;           ///< manual_capture: ~capture_pose called for this rest
+  ros::WallTime last_imu_wall;          ///< receipt time of the newest IMU message
+  bool input_stopped = true;            ///< no IMU for a while: the rest in progress was closed
   ros::WallTimer stale_timer;
+  std::uint64_t imu_gaps_warned = 0;  ///< pipeline->imuGaps() when last warned about
+  // The magnetometer's frame differs from the IMU's: R_imu_mag from tf, looked up at most once
+  // per second until found.
+  std::unique_ptr<tf2_ros::Buffer> tf_buffer;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener;
+  ros::WallTime last_mag_lookup;
+  void lookUpMagnetometerRotation();
   /// IMU silent for 2 s of wall time (a bag ended, a driver stopped): close the rest in progress
   /// so that the last pose counts.
   void checkStale();
@@ -58,16 +67,22 @@ struct AlignmentWrapper::Impl {
   /// camera_pose (geometry_msgs/PoseStamped, the camera in the target frame): orientations from
   /// the user's own detector or motion capture instead of images.
   void onCameraPose(const geometry_msgs::PoseStampedConstPtr& msg);
-  /// Stamp check shared by the inputs: a jump back by more than a second (a bag loop) resets the
-  /// buffers with a warning. False when the message is to be dropped.
-  bool acceptStamp(const ros::Time& stamp, const char* topic);
+  /// Stamp check shared by the inputs: a zero stamp is dropped (counted); a jump back by more
+  /// than a second on one input (a bag loop) resets the buffers with a warning. False when the
+  /// message is to be dropped.
+  bool acceptStamp(const std_msgs::Header& header, InputStream stream);
   void applyPendingReset();
+  /// The topic an input stream arrives on (resolved name), for messages.
+  std::string topicOf(InputStream stream) const;
 
   // --- pipeline callbacks
   void onPose(const StationaryPose& pose);
   void onPoseRejected(const RejectedPose& rejected);
   void onResult(const AlignmentResult& result);
-  void onReject(RejectReason reason, const std::string& detail);
+  void onReject(RejectReason reason, InputStream stream, const std::string& detail);
+  /// Warnings are throttled per input and reason: a flood of one kind hides no other.
+  std::map<std::pair<InputStream, RejectReason>, ros::WallTime> last_reject_warning;
+  std::map<std::pair<InputStream, RejectReason>, std::uint64_t> unwarned_rejects;
   int inconsistent_poses = 0;  ///< consecutive poses that disagree with the broadcast estimate
 
   // --- outputs (alignment_outputs.cpp)
@@ -84,7 +99,7 @@ struct AlignmentWrapper::Impl {
   std::uint64_t imu_count = 0, mag_count = 0, image_count = 0;
   ros::WallTime last_diagnostics = ros::WallTime::now();
   ros::ServiceServer calibrate_srv, reset_srv, save_srv, capture_srv;
-  ros::Timer status_timer;
+  ros::WallTimer status_timer;
   diagnostic_updater::Updater diagnostics;
   std::optional<AlignmentResult> last_result;      ///< latest solve
   std::optional<Eigen::Matrix3d> broadcast_R;      ///< what the static tf says now
@@ -93,11 +108,14 @@ struct AlignmentWrapper::Impl {
   std::string state_message = "waiting for IMU and camera data";
   bool recalibrating = false;
   std::optional<StationaryPose> last_pose;
+  std::string saved_camera_frame,
+      saved_imu_frame;  ///< from the loaded file, until inputs name them
 
   void advertise();
   std::optional<PublishedEstimate> published;  ///< judgeEstimate's reference
   void broadcast(const Eigen::Matrix3d& R_cam_imu, double max_std_dev_deg);
   bool save(const AlignmentResult& result, std::string* error);
+  std::string save_error;  ///< why the last save failed ("" after a good one): diagnostics
   void loadSaved();
   void publishStatus();
   void publishPoses();  ///< ~stationary_poses and ~target_pose

@@ -19,7 +19,7 @@
 #include "camera_imu_alignment/csv_io.h"
 #include "camera_imu_alignment/pipeline_config.h"
 #include "camera_imu_alignment/result_yaml.h"
-#include "camera_imu_alignment/ros/message_conversion.h"
+#include "camera_imu_alignment/ros/message_input.h"
 #include "camera_imu_alignment/ros/wrapper_settings.h"
 #include "camera_imu_alignment/rotation_math.h"
 #include "camera_imu_alignment/target_description.h"
@@ -89,12 +89,17 @@ class Progress {
   int last_ = -100;
 };
 
-/// Prints the first few rejections of each reason, then only counts (summary at the end).
+/// Prints the first few rejections of each reason, naming the bag topic, then only counts (the
+/// summary at the end has them all).
 class RejectLog {
  public:
-  void operator()(cia::RejectReason reason, const std::string& detail) {
+  explicit RejectLog(const cia::BagTopics& topics) : topics_(topics) {}
+  void operator()(cia::RejectReason reason, cia::InputStream stream, const std::string& detail) {
     const int n = ++shown_[reason];
-    if (n <= 3) std::cerr << "[calibrate_bag] rejected: " << detail << "\n";
+    if (n <= 3) {
+      std::cerr << "[calibrate_bag] " << topicOf(stream) << ": rejected ("
+                << cia::rejectReasonName(reason) << "): " << detail << "\n";
+    }
     if (n == 3) {
       std::cerr << "[calibrate_bag] (further '" << cia::rejectReasonName(reason)
                 << "' rejections are counted, not shown)\n";
@@ -102,12 +107,25 @@ class RejectLog {
   }
 
  private:
+  std::string topicOf(cia::InputStream stream) const {
+    switch (stream) {
+      case cia::InputStream::kImu:
+        return topics_.imu;
+      case cia::InputStream::kMagnetometer:
+        return topics_.mag;
+      case cia::InputStream::kImage:
+        return topics_.image;
+      case cia::InputStream::kCameraInfo:
+        return topics_.camera_info;
+      case cia::InputStream::kCameraPose:
+        break;
+    }
+    return cia::inputStreamName(stream);
+  }
+
+  cia::BagTopics topics_;
   std::map<cia::RejectReason, int> shown_;
 };
-
-std::string stripSlash(const std::string& frame) {
-  return !frame.empty() && frame[0] == '/' ? frame.substr(1) : frame;
-}
 
 struct RunInfo {
   std::string camera_frame, imu_frame;
@@ -124,55 +142,31 @@ void readBag(const rosbag::Bag& bag, const cia::BagTopics& topics,
     if (!t.empty()) names.push_back(t);
   }
   rosbag::View view(bag, rosbag::TopicQuery(names));
-  bool have_info = false;
+  // The nodelet's checks and conversions (MessageInput), so that both refuse the same messages.
+  cia::MessageInput input(pipeline, [](const std::string& notice) {
+    std::cerr << "[calibrate_bag] note: " << notice << "\n";
+  });
   for (const rosbag::MessageInstance& m : view) {
     const std::string& topic = m.getTopic();
     if (topic == topics.imu) {
-      const auto msg = m.instantiate<sensor_msgs::Imu>();
-      if (!msg) continue;
-      if (info->imu_frame.empty()) info->imu_frame = stripSlash(msg->header.frame_id);
-      pipeline->addImu(cia::toImuSample(*msg));
+      if (const auto msg = m.instantiate<sensor_msgs::Imu>()) input.addImu(*msg);
     } else if (topic == topics.mag) {
-      if (const auto msg = m.instantiate<sensor_msgs::MagneticField>()) {
-        pipeline->addMagnetic(cia::toMagneticSample(*msg));
-      }
+      if (const auto msg = m.instantiate<sensor_msgs::MagneticField>()) input.addMagnetic(*msg);
     } else if (topic == topics.camera_info) {
       ++info->info_messages;
-      const auto msg = m.instantiate<sensor_msgs::CameraInfo>();
-      if (!msg || (have_info && pipeline->hasIntrinsics())) continue;  // constant per camera
-      cia::CameraIntrinsics intrinsics;
-      std::string error;
-      if (!cia::toCameraIntrinsics(*msg, &intrinsics, &error)) {
-        std::cerr << "[calibrate_bag] " << topics.camera_info << ": " << error << "\n";
-        continue;
-      }
-      have_info = pipeline->setCameraIntrinsics(intrinsics);
+      if (const auto msg = m.instantiate<sensor_msgs::CameraInfo>()) input.setCameraInfo(*msg);
     } else if (topic == topics.image) {
       ++info->image_messages;
-      cia::CameraFrame frame;
-      std::string error, frame_id;
-      bool ok = false;
       if (topics.image_compressed) {
-        if (const auto msg = m.instantiate<sensor_msgs::CompressedImage>()) {
-          frame.stamp_s = msg->header.stamp.toSec();
-          frame_id = msg->header.frame_id;
-          ok = cia::toMono8(*msg, &frame.mono8, &error);
-        }
+        if (const auto msg = m.instantiate<sensor_msgs::CompressedImage>()) input.addImage(*msg);
       } else if (const auto msg = m.instantiate<sensor_msgs::Image>()) {
-        frame.stamp_s = msg->header.stamp.toSec();
-        frame_id = msg->header.frame_id;
-        ok = cia::toMono8(*msg, &frame.mono8, &error);
+        input.addImage(*msg);
       }
-      if (info->camera_frame.empty()) info->camera_frame = stripSlash(frame_id);
-      if (!ok) frame.mono8.release();  // counted as a bad image by the pipeline
-      if (!ok && !error.empty()) {
-        static int shown = 0;
-        if (++shown <= 3) std::cerr << "[calibrate_bag] " << topics.image << ": " << error << "\n";
-      }
-      pipeline->addFrame(frame);
     }
     progress->update(m.getTime().toSec(), *pipeline);
   }
+  info->imu_frame = input.imuFrame();
+  info->camera_frame = input.cameraFrame();
   pipeline->finish();
   progress->update(info->end_s, *pipeline, true);
   progress->done();
@@ -235,9 +229,11 @@ int run(const cia::CliArgs& args) {
             << target.describe() << "\n";
 
   // --- Run the pipeline over the bag.
-  RejectLog reject_log;
+  RejectLog reject_log(topics);
   cia::PipelineCallbacks callbacks;
-  callbacks.on_reject = [&](cia::RejectReason r, const std::string& d) { reject_log(r, d); };
+  callbacks.on_reject = [&](cia::RejectReason r, cia::InputStream stream, const std::string& d) {
+    reject_log(r, stream, d);
+  };
   cia::CalibrationPipeline pipeline(target, settings, callbacks);
   Progress progress(!args.has("--quiet"), info.start_s, info.end_s);
   try {
