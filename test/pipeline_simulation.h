@@ -20,6 +20,7 @@ namespace test {
 struct Injection {
   int nan_imu_every = 0, duplicate_imu_every = 0, backwards_imu_every = 0;
   int nan_mag_every = 0, gauss_mag_every = 0, empty_frame_every = 0;
+  double cover_fraction = 0.0;  ///< this much of every frame (from the right) painted grey
 };
 struct Injected {
   std::uint64_t nan_imu = 0, duplicate_imu = 0, backwards_imu = 0;
@@ -133,9 +134,13 @@ inline PipelineRun feedPipeline(std::unique_ptr<simulation::SimulationRun> simul
     } else {
       grey = renderer.renderAt(run.trajectory, t);
     }
-    pipeline.addFrame(
-        {stamp, sim::ImageRenderer::toMono8(grey, c.noise_scale * c.pixel_noise_sigma,
-                                            run.frameNoiseSeed(static_cast<long>(j)))});
+    cv::Mat mono8 = sim::ImageRenderer::toMono8(grey, c.noise_scale * c.pixel_noise_sigma,
+                                                run.frameNoiseSeed(static_cast<long>(j)));
+    if (injection.cover_fraction > 0.0) {  // the target partly or wholly out of view
+      const int covered = static_cast<int>(injection.cover_fraction * mono8.cols);
+      mono8(cv::Rect(mono8.cols - covered, 0, covered, mono8.rows)).setTo(cv::Scalar(128));
+    }
+    pipeline.addFrame({stamp, mono8});
   }
   feedInertialUpTo(std::numeric_limits<double>::infinity());
   pipeline.finish();

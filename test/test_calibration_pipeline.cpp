@@ -289,6 +289,28 @@ TEST(CalibrationPipeline, BadSamplesAreCountedAndDropped) {
   expectAccurate(r, 0.1);
 }
 
+TEST(CalibrationPipeline, ATargetPartlyOrNotInViewIsCountedAndGivesNoPose) {
+  for (const double covered : {0.5, 1.0}) {
+    sim::SimulationConfig c = scenario("nominal", 23);
+    c.num_poses = 2;
+    test::Injection injection;
+    injection.cover_fraction = covered;
+    PipelineSettings settings;
+    settings.min_frame_interval_s = 0.5;  // fewer (slow) failing detections
+    const auto r = test::runPipeline(c, settings, injection);
+    EXPECT_EQ(r.pipeline->posesTotal(), 0u) << covered;
+    EXPECT_GT(r.pipeline->framesDetected(), 0u) << covered;
+    // Every detection attempt at rest failed and was counted; none was taken for a pose.
+    EXPECT_EQ(r.pipeline->rejections().count(RejectReason::kTargetNotFound),
+              r.pipeline->framesDetected())
+        << covered;
+    ASSERT_FALSE(r.pipeline->rejectedPoses().empty()) << covered;
+    EXPECT_NE(r.pipeline->rejectedPoses()[0].reason.find("target seen in 0"), std::string::npos)
+        << r.pipeline->rejectedPoses()[0].reason;
+    EXPECT_TRUE(r.results.empty()) << covered;
+  }
+}
+
 }  // namespace
 }  // namespace camera_imu_alignment
 

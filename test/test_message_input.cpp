@@ -357,14 +357,16 @@ TEST(MessageInput, AKnownMagnetometerRotationIsApplied) {
   EXPECT_NEAR(rad2deg(rotationAngle(truth.transpose() * ignored)), 30.0, 1e-6);
 }
 
-TEST(MessageInput, ImuGapsAreCountedAndEndTheRest) {
+TEST(MessageInput, ImuGapsAreCountedAndEndTheRestAndRateDropsAreFine) {
   Boundary b;
-  for (int i = 0; i < 800; ++i) b.input->addImu(imuAt(1.0 + i * 0.005));
-  const double after_gap = 1.0 + 799 * 0.005 + 0.5;  // 0.5 s without data
-  for (int i = 0; i < 800; ++i) b.input->addImu(imuAt(after_gap + i * 0.005));
+  for (int i = 0; i < 800; ++i) b.input->addImu(imuAt(1.0 + i * 0.005));       // 4 s at 200 Hz
+  const double after_gap = 1.0 + 799 * 0.005 + 0.5;                            // 0.5 s without data
+  for (int i = 0; i < 100; ++i) b.input->addImu(imuAt(after_gap + i * 0.04));  // 4 s at 25 Hz
   b.pipeline->finish();
   EXPECT_EQ(b.pipeline->imuGaps(), 1u);
-  EXPECT_EQ(b.pipeline->restsTotal(), 2u);  // the gap split the rest in two
+  EXPECT_EQ(b.pipeline->restsTotal(), 2u);  // the gap split the rest; the slow part is a rest too
+  ASSERT_EQ(b.pipeline->segments().size(), 2u);
+  EXPECT_NEAR(b.pipeline->segments()[1].end_s, after_gap + 99 * 0.04, 0.6);
 }
 
 TEST(ClockJumpDetector, ACameraLaggingTheImuIsNotAJump) {
