@@ -11,6 +11,7 @@
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/MagneticField.h>
 #include <std_srvs/Trigger.h>
+#include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
 #include <Eigen/Geometry>
@@ -397,6 +398,14 @@ TEST_F(AlignmentRos, HostileInputsAreCountedByReasonAndNothingBreaks) {
     mag_pub.publish(m);
     pause();
   };
+  // The magnetometer's frame is the IMU's turned by 90 deg about z (as a URDF would say).
+  tf2_ros::StaticTransformBroadcaster static_tf;
+  geometry_msgs::TransformStamped imu_to_mag;
+  imu_to_mag.header.stamp = ros::Time(100.0);
+  imu_to_mag.header.frame_id = "imu";
+  imu_to_mag.child_frame_id = "magnetometer";
+  imu_to_mag.transform.rotation.z = imu_to_mag.transform.rotation.w = std::sqrt(0.5);
+  static_tf.sendTransform(imu_to_mag);
   mag(101.0, 0.2, -0.4);    // gauss: magnetic_units
   mag(101.1, 20.0, -40.0);  // microtesla: magnetic_units
   mag(101.2, 0.0, 0.0);     // zero_vector
@@ -430,6 +439,11 @@ TEST_F(AlignmentRos, HostileInputsAreCountedByReasonAndNothingBreaks) {
   pose.header.stamp = ros::Time(101.1);
   pose.pose.orientation.w = 2.0;  // non_finite: not a unit quaternion
   pose_pub.publish(pose);
+  // The node looks the magnetometer's rotation up in tf at most once a second until found.
+  for (double t : {101.5, 101.6}) {
+    ros::WallDuration(1.2).sleep();
+    mag(t, 2e-5, -4e-5);
+  }
 
   const std::map<std::string, long> expected = {
       {"rejected non_finite", 4},      {"rejected zero_vector", 2},
@@ -452,12 +466,12 @@ TEST_F(AlignmentRos, HostileInputsAreCountedByReasonAndNothingBreaks) {
   node.stop();
   const std::string log = node.log();
   EXPECT_TRUE(alive) << log;
-  for (const char* warning :
-       {"/hostile/imu/data_raw: rejected (non_finite)",
-        "/hostile/imu/mag: rejected (magnetic_units)",
-        "/hostile/camera/image_raw: rejected (bad_image)",
-        "/hostile/camera/camera_info: rejected (bad_camera_info)",
-        "/hostile/camera_pose: rejected (non_finite)", "starts with '/'", "'magnetometer'"}) {
+  for (const char* warning : {"/hostile/imu/data_raw: rejected (non_finite)",
+                              "/hostile/imu/mag: rejected (magnetic_units)",
+                              "/hostile/camera/image_raw: rejected (bad_image)",
+                              "/hostile/camera/camera_info: rejected (bad_camera_info)",
+                              "/hostile/camera_pose: rejected (non_finite)", "starts with '/'",
+                              "'magnetometer'", "rotated from 'magnetometer' into 'imu' (tf)"}) {
     EXPECT_NE(log.find(warning), std::string::npos) << warning << "\n" << log;
   }
   EXPECT_EQ(log.find("nan"), std::string::npos) << log;

@@ -4,6 +4,8 @@
 // told apart from a camera's latency.
 #include <gtest/gtest.h>
 
+#include <tf2/buffer_core.h>
+
 #include <cmath>
 #include <limits>
 #include <map>
@@ -320,19 +322,30 @@ TEST(MessageInput, FrameIdsLoseTheirLeadingSlashAndDifferentMagFramesAreNoted) {
 
 /// One rest (IMU level, the field along `field_mag` in the magnetometer frame), then motion: the
 /// pose's accelerometer + magnetometer attitude.
+/// `mag_frame`: the magnetometer messages' frame_id; `tf`: where MessageInput may look up its
+/// rotation into the IMU frame.
 Eigen::Matrix3d accelMagAttitude(const Eigen::Vector3d& field_mag,
-                                 const std::optional<Eigen::Matrix3d>& R_imu_mag) {
+                                 const std::optional<Eigen::Matrix3d>& R_imu_mag,
+                                 const std::string& mag_frame = "imu_link",
+                                 const tf2::BufferCore* tf = nullptr,
+                                 std::vector<std::string>* notices = nullptr) {
   Boundary b;
   if (R_imu_mag) b.input->setMagnetometerRotation(*R_imu_mag);
+  b.input->setTransforms(tf);
   for (int i = 0; i < 1000; ++i) {  // 4 s at 200 Hz at rest, then 1 s turning
     const double t = 1.0 + i * 0.005;
     const bool moving = i >= 800;
     b.input->addImu(
         imuAt(t, {0.0, 0.0, 9.81}, moving ? Eigen::Vector3d(0, 0, 1.0) : Eigen::Vector3d::Zero()));
-    if (i % 4 == 0) b.input->addMagnetic(magAt(t, field_mag));
+    if (i % 4 == 0) {
+      sensor_msgs::MagneticField mag = magAt(t, field_mag);
+      mag.header.frame_id = mag_frame;
+      b.input->addMagnetic(mag);
+    }
     if (i % 20 == 0) b.input->addCameraPose(cameraPose(t, Eigen::Quaterniond::Identity()));
   }
   b.pipeline->finish();
+  if (notices) *notices = b.notices;
   EXPECT_GE(b.poses.size(), 1u) << b.pipeline->restsTotal() << " rests; "
                                 << b.pipeline->rejections().summary() << " "
                                 << (b.pipeline->rejectedPoses().empty()
@@ -355,6 +368,51 @@ TEST(MessageInput, AKnownMagnetometerRotationIsApplied) {
   const Eigen::Matrix3d ignored = accelMagAttitude(field_mag, std::nullopt);
   EXPECT_LT(rad2deg(rotationAngle(truth.transpose() * rotated)), 1e-6);
   EXPECT_NEAR(rad2deg(rotationAngle(truth.transpose() * ignored)), 30.0, 1e-6);
+}
+
+TEST(MessageInput, AMagnetometerRotationIsLookedUpInTf) {
+  // As a robot_state_publisher would say it: imu_link -> mag, the magnetometer yawed by 30 deg.
+  const Eigen::Quaterniond q_imu_mag(Eigen::AngleAxisd(M_PI / 6, Eigen::Vector3d::UnitZ()));
+  tf2::BufferCore tf;
+  geometry_msgs::TransformStamped t;
+  t.header.frame_id = "imu_link";
+  t.child_frame_id = "mag";
+  t.transform.rotation.x = q_imu_mag.x();
+  t.transform.rotation.y = q_imu_mag.y();
+  t.transform.rotation.z = q_imu_mag.z();
+  t.transform.rotation.w = q_imu_mag.w();
+  ASSERT_TRUE(tf.setTransform(t, "test", true));
+  const Eigen::Vector3d field_imu(2e-5, 0.0, -4e-5);
+  const Eigen::Vector3d field_mag = q_imu_mag.conjugate() * field_imu;
+  const Eigen::Matrix3d truth = accelMagAttitude(field_imu, std::nullopt);
+  std::vector<std::string> notices;
+  const Eigen::Matrix3d looked_up = accelMagAttitude(field_mag, std::nullopt, "mag", &tf, &notices);
+  EXPECT_LT(rad2deg(rotationAngle(truth.transpose() * looked_up)), 1e-6);
+  ASSERT_FALSE(notices.empty());
+  EXPECT_NE(notices.back().find("rotated from 'mag' into 'imu_link' (tf)"), std::string::npos)
+      << notices.back();
+  // Unknown in tf (another frame): the IMU's axes, with the notice saying so.
+  const Eigen::Matrix3d unknown =
+      accelMagAttitude(field_mag, std::nullopt, "other_mag", &tf, &notices);
+  EXPECT_NEAR(rad2deg(rotationAngle(truth.transpose() * unknown)), 30.0, 1e-6);
+  ASSERT_FALSE(notices.empty());
+  EXPECT_NE(notices.back().find("differs from the IMU's"), std::string::npos) << notices.back();
+}
+
+TEST(MessageInput, ARotationFoundForOtherFramesIsDropped) {
+  Boundary b;
+  b.input->addImu(imuAt(1.0));
+  sensor_msgs::MagneticField mag = magAt(1.0);
+  mag.header.frame_id = "mag";
+  b.input->addMagnetic(mag);
+  EXPECT_TRUE(b.input->needsMagnetometerRotation());
+  b.input->setMagnetometerRotation(Eigen::Matrix3d::Identity());
+  EXPECT_FALSE(b.input->needsMagnetometerRotation());
+  mag.header.frame_id = "mag2";  // a different sensor now
+  mag.header.stamp = ros::Time(1.1);
+  b.input->addMagnetic(mag);
+  EXPECT_TRUE(b.input->needsMagnetometerRotation());
+  EXPECT_FALSE(b.input->hasMagnetometerRotation());
 }
 
 TEST(MessageInput, ImuGapsAreCountedAndEndTheRestAndRateDropsAreFine) {

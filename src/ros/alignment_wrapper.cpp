@@ -117,31 +117,15 @@ void AlignmentWrapper::Impl::onImu(const sensor_msgs::ImuConstPtr& msg) {
 void AlignmentWrapper::Impl::onMag(const sensor_msgs::MagneticFieldConstPtr& msg) {
   if (!acceptStamp(msg->header, InputStream::kMagnetometer)) return;
   ++mag_count;
-  if (input->needsMagnetometerRotation()) lookUpMagnetometerRotation();
-  input->addMagnetic(*msg);
-  applyPendingReset();
-}
-
-void AlignmentWrapper::Impl::lookUpMagnetometerRotation() {
-  if ((ros::WallTime::now() - last_mag_lookup).toSec() < 1.0) return;
-  last_mag_lookup = ros::WallTime::now();
-  if (!tf_buffer) {
+  if (!tf_buffer && !input->imuFrame().empty() &&
+      normalizeFrameId(msg->header.frame_id) != input->imuFrame()) {
+    // The magnetometer has a frame of its own: its rotation into the IMU frame comes from tf.
     tf_buffer = std::make_unique<tf2_ros::Buffer>();
     tf_listener = std::make_unique<tf2_ros::TransformListener>(*tf_buffer, nh);
-    return;  // give the listener a moment to receive /tf_static
+    input->setTransforms(tf_buffer.get());
   }
-  try {
-    const geometry_msgs::TransformStamped t =
-        tf_buffer->lookupTransform(input->imuFrame(), input->magFrame(), ros::Time(0));
-    const auto& q = t.transform.rotation;
-    const Eigen::Quaterniond q_imu_mag(q.w, q.x, q.y, q.z);
-    if (!std::isfinite(q_imu_mag.norm()) || std::abs(q_imu_mag.norm() - 1.0) > 1e-3) return;
-    input->setMagnetometerRotation(q_imu_mag.normalized().toRotationMatrix());
-    ROS_INFO("camera_imu_alignment: magnetometer field rotated from '%s' into '%s' (tf)",
-             input->magFrame().c_str(), input->imuFrame().c_str());
-  } catch (const tf2::TransformException&) {
-    // Not (yet) known: the axes are taken to be the IMU's (MessageInput said so once).
-  }
+  input->addMagnetic(*msg);
+  applyPendingReset();
 }
 
 void AlignmentWrapper::Impl::onImage(const sensor_msgs::ImageConstPtr& image,

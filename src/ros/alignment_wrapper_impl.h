@@ -40,6 +40,10 @@ struct AlignmentWrapper::Impl {
   std::unique_ptr<CalibrationPipeline> pipeline;
 
   // --- inputs
+  // The magnetometer's frame differs from the IMU's: R_imu_mag from tf, looked up by MessageInput
+  // (declared before the subscribers, so that it outlives their callbacks).
+  std::unique_ptr<tf2_ros::Buffer> tf_buffer;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener;
   image_transport::ImageTransport transport;
   ros::Subscriber imu_sub, mag_sub, camera_pose_sub;
   image_transport::CameraSubscriber camera_sub;
@@ -51,12 +55,6 @@ struct AlignmentWrapper::Impl {
   bool input_stopped = true;            ///< no IMU for a while: the rest in progress was closed
   ros::WallTimer stale_timer;
   std::uint64_t imu_gaps_warned = 0;  ///< pipeline->imuGaps() when last warned about
-  // The magnetometer's frame differs from the IMU's: R_imu_mag from tf, looked up at most once
-  // per second until found.
-  std::unique_ptr<tf2_ros::Buffer> tf_buffer;
-  std::unique_ptr<tf2_ros::TransformListener> tf_listener;
-  ros::WallTime last_mag_lookup;
-  void lookUpMagnetometerRotation();
   /// IMU silent for 2 s of wall time (a bag ended, a driver stopped): close the rest in progress
   /// so that the last pose counts.
   void checkStale();

@@ -1,6 +1,9 @@
 // MessageInput: the checks only ROS messages need, then conversion and the pipeline.
 #include "camera_imu_alignment/ros/message_input.h"
 
+#include <tf2/exceptions.h>
+
+#include <Eigen/Geometry>
 #include <cmath>
 #include <sstream>
 
@@ -28,7 +31,11 @@ bool MessageInput::checkStamp(const std_msgs::Header& header, InputStream stream
 void MessageInput::noteFrame(const std::string& frame_id, std::string* kept, const char* input) {
   if (frame_id.empty() || frame_id == *kept) return;
   const std::string normalized = normalizeFrameId(frame_id);
-  if (normalized == *kept) return;  // the same frame, with and without the slash
+  if (normalized == *kept) return;                 // the same frame, with and without the slash
+  if (!kept->empty() && kept != &camera_frame_) {  // a rotation found for other frames is void
+    R_imu_mag_.reset();
+    last_lookup_ = std::chrono::steady_clock::time_point{};
+  }
   *kept = normalized;
   if (normalized != frame_id && notice_) {
     notice_(std::string(input) + " frame_id '" + frame_id + "' starts with '/': used as '" +
@@ -56,9 +63,36 @@ void MessageInput::setMagnetometerRotation(const Eigen::Matrix3d& R_imu_mag) {
   R_imu_mag_ = R_imu_mag;
 }
 
+void MessageInput::setTransforms(const tf2::BufferCore* tf) {
+  tf_ = tf;
+  last_lookup_ = std::chrono::steady_clock::time_point{};
+}
+
+void MessageInput::lookUpMagnetometerRotation() {
+  if (!tf_ || !needsMagnetometerRotation()) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (now - last_lookup_ < std::chrono::seconds(1)) return;
+  last_lookup_ = now;
+  geometry_msgs::TransformStamped t;
+  try {
+    t = tf_->lookupTransform(imu_frame_, mag_frame_, ros::Time(0));
+  } catch (const tf2::TransformException&) {
+    return;  // not (yet) known
+  }
+  const auto& r = t.transform.rotation;
+  const Eigen::Quaterniond q_imu_mag(r.w, r.x, r.y, r.z);
+  if (!std::isfinite(q_imu_mag.norm()) || std::abs(q_imu_mag.norm() - 1.0) > 1e-3) return;
+  setMagnetometerRotation(q_imu_mag.normalized().toRotationMatrix());
+  if (notice_) {
+    notice_("the magnetometer's field is rotated from '" + mag_frame_ + "' into '" + imu_frame_ +
+            "' (tf)");
+  }
+}
+
 void MessageInput::addImu(const sensor_msgs::Imu& msg) {
   if (!checkStamp(msg.header, InputStream::kImu)) return;
   noteFrame(msg.header.frame_id, &imu_frame_, "the IMU's");
+  lookUpMagnetometerRotation();
   checkMagFrame();
   pipeline_->addImu(toImuSample(msg));
 }
@@ -66,6 +100,7 @@ void MessageInput::addImu(const sensor_msgs::Imu& msg) {
 void MessageInput::addMagnetic(const sensor_msgs::MagneticField& msg) {
   if (!checkStamp(msg.header, InputStream::kMagnetometer)) return;
   noteFrame(msg.header.frame_id, &mag_frame_, "the magnetometer's");
+  lookUpMagnetometerRotation();
   checkMagFrame();
   MagneticSample sample = toMagneticSample(msg);
   if (R_imu_mag_) sample.field_t = *R_imu_mag_ * sample.field_t;

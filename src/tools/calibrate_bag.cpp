@@ -5,6 +5,8 @@
 // information (too few poses, not observable: the message names the axis to rotate about).
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
+#include <tf2/buffer_core.h>
+#include <tf2_msgs/TFMessage.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -133,6 +135,20 @@ struct RunInfo {
   double start_s = 0.0, end_s = 0.0;
 };
 
+/// The bag's static transforms (/tf_static, e.g. the magnetometer's frame in the IMU's).
+void readStaticTransforms(const rosbag::Bag& bag, tf2::BufferCore* tf) {
+  rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{"/tf_static", "tf_static"}));
+  for (const rosbag::MessageInstance& m : view) {
+    const auto msg = m.instantiate<tf2_msgs::TFMessage>();
+    if (!msg) continue;
+    for (geometry_msgs::TransformStamped t : msg->transforms) {
+      t.header.frame_id = cia::normalizeFrameId(t.header.frame_id);
+      t.child_frame_id = cia::normalizeFrameId(t.child_frame_id);
+      tf->setTransform(t, "bag", true);  // a bad transform is refused by tf2 (logged)
+    }
+  }
+}
+
 /// Feeds every message of the selected topics to the pipeline. Throws rosbag exceptions on a
 /// corrupt or truncated bag.
 void readBag(const rosbag::Bag& bag, const cia::BagTopics& topics,
@@ -146,6 +162,9 @@ void readBag(const rosbag::Bag& bag, const cia::BagTopics& topics,
   cia::MessageInput input(pipeline, [](const std::string& notice) {
     std::cerr << "[calibrate_bag] note: " << notice << "\n";
   });
+  tf2::BufferCore static_tf;
+  readStaticTransforms(bag, &static_tf);
+  input.setTransforms(&static_tf);
   for (const rosbag::MessageInstance& m : view) {
     const std::string& topic = m.getTopic();
     if (topic == topics.imu) {

@@ -8,6 +8,7 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/MagneticField.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -79,6 +80,8 @@ const std::set<std::string> kValueOptions = {"--out",
                                              "--camera-info-topic",
                                              "--imu-frame",
                                              "--camera-frame",
+                                             "--mag-frame",
+                                             "--mag-frame-yaw-deg",
                                              "--start-time-s",
                                              "--compression"};
 const std::set<std::string> kFlags = {"--help",      "-h",        "--no-magnetometer",
@@ -115,6 +118,9 @@ std::string usage() {
        "  --imu-topic (imu/data_raw) --mag-topic (imu/mag) --image-topic (camera/image_raw)\n"
        "  --camera-info-topic (camera/camera_info) --imu-frame (imu_link) --camera-frame "
        "(camera_optical_frame)\n"
+       "  --mag-frame NAME --mag-frame-yaw-deg D (IMU frame, 0): magnetometer messages in frame "
+       "NAME,\n"
+       "    whose axes are the IMU's turned by D about its z; the rotation goes to /tf_static\n"
        "  --start-time-s (1700000000)  --compression none|lz4|bz2 (none)\n";
   return o.str();
 }
@@ -287,9 +293,31 @@ sensor_msgs::CameraInfo cameraInfo(const sim::SimulationConfig& c) {
 
 }  // namespace
 
+/// How the bag is written (beyond the simulation itself).
+struct BagOptions {
+  std::string compression = "none";  ///< none, lz4 or bz2
+  std::string mag_frame;             ///< frame_id of the magnetometer; empty: the IMU's
+  double mag_frame_yaw_rad = 0.0;    ///< R_imu_mag = rotation about the IMU's z by this angle
+};
+
+/// The static transform imu_frame -> mag_frame (rotation R_imu_mag: magnetometer axes to IMU axes).
+tf2_msgs::TFMessage magnetometerTf(const sim::SimulationConfig& c, const BagOptions& o) {
+  geometry_msgs::TransformStamped t;
+  t.header.stamp = ros::Time(c.start_time_s);
+  t.header.frame_id = c.imu_frame;
+  t.child_frame_id = o.mag_frame;
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(o.mag_frame_yaw_rad, Eigen::Vector3d::UnitZ()));
+  t.transform.rotation.x = q.x();
+  t.transform.rotation.y = q.y();
+  t.transform.rotation.z = q.z();
+  t.transform.rotation.w = q.w();
+  tf2_msgs::TFMessage msg;
+  msg.transforms.push_back(t);
+  return msg;
+}
+
 /// Writes the bag, messages merged in stamp order; returns the number of rendered images.
-int writeBag(const sim::SimulationRun& run, const std::string& path,
-             const std::string& compression) {
+int writeBag(const sim::SimulationRun& run, const std::string& path, const BagOptions& options) {
   const sim::SimulationConfig& c = run.config;
   const sim::BadInputPlan& bad = run.bad_input;
   const double t0 = c.start_time_s, nan = std::numeric_limits<double>::quiet_NaN();
@@ -299,8 +327,17 @@ int writeBag(const sim::SimulationRun& run, const std::string& path,
   } catch (const rosbag::BagException& e) {
     throw cia::UsageError("--out: cannot write " + path + ": " + e.what());
   }
-  if (compression == "lz4") bag.setCompression(rosbag::compression::LZ4);
-  if (compression == "bz2") bag.setCompression(rosbag::compression::BZ2);
+  if (options.compression == "lz4") bag.setCompression(rosbag::compression::LZ4);
+  if (options.compression == "bz2") bag.setCompression(rosbag::compression::BZ2);
+  const std::string mag_frame = options.mag_frame.empty() ? c.imu_frame : options.mag_frame;
+  // Field in magnetometer axes: f_mag = R_imu_mag^T f_imu.
+  const Eigen::Matrix3d R_mag_imu =
+      Eigen::AngleAxisd(options.mag_frame_yaw_rad, Eigen::Vector3d::UnitZ())
+          .toRotationMatrix()
+          .transpose();
+  if (mag_frame != c.imu_frame && c.magnetometer) {
+    bag.write("/tf_static", ros::Time(c.start_time_s), magnetometerTf(c, options));
+  }
   const sim::ImageRenderer renderer(sim::CameraModel::fromConfig(c),
                                     sim::makeTargetTexture(c.target, sim::textureTexelFor(c)),
                                     c.supersample, c.blur_sigma_px);
@@ -345,11 +382,12 @@ int writeBag(const sim::SimulationRun& run, const std::string& path,
          ++next_mag) {
       const sim::MagSample& s = run.mag[next_mag];
       sensor_msgs::MagneticField m;
-      setHeader(&m.header, &mag_seq, t0 + s.t, c.imu_frame);
+      setHeader(&m.header, &mag_seq, t0 + s.t, mag_frame);
       const bool is_nan = contains(bad.nan_mag, next_mag);
-      m.magnetic_field.x = is_nan ? nan : s.field.x();
-      m.magnetic_field.y = is_nan ? nan : s.field.y();
-      m.magnetic_field.z = is_nan ? nan : s.field.z();
+      const Eigen::Vector3d field = R_mag_imu * s.field;
+      m.magnetic_field.x = is_nan ? nan : field.x();
+      m.magnetic_field.y = is_nan ? nan : field.y();
+      m.magnetic_field.z = is_nan ? nan : field.z();
       for (int d = 0; d < 3; ++d) m.magnetic_field_covariance[4 * d] = mag_var;
       bag.write(c.mag_topic, ros::Time(t0 + s.t), m);
     }
@@ -424,17 +462,26 @@ int main(int argc, char** argv) {
     if (out.size() < 5 || out.compare(out.size() - 4, 4, ".bag") != 0) {
       throw cia::UsageError("--out must name a file ending in .bag, got '" + out + "'");
     }
-    const std::string compression = args.get("--compression", "none");
-    if (compression != "none" && compression != "lz4" && compression != "bz2") {
+    BagOptions bag_options;
+    bag_options.compression = args.get("--compression", "none");
+    if (bag_options.compression != "none" && bag_options.compression != "lz4" &&
+        bag_options.compression != "bz2") {
       throw cia::UsageError("--compression must be none, lz4 or bz2");
     }
+    bag_options.mag_frame = args.get("--mag-frame", "");
+    bag_options.mag_frame_yaw_rad =
+        cia::deg2rad(args.getDouble("--mag-frame-yaw-deg", 0.0, -360.0, 360.0));
     const sim::SimulationConfig config = configFromArgs(args);
+    if (bag_options.mag_frame_yaw_rad != 0.0 &&
+        (bag_options.mag_frame.empty() || bag_options.mag_frame == config.imu_frame)) {
+      throw cia::UsageError("--mag-frame-yaw-deg needs a --mag-frame other than the IMU's frame");
+    }
     const auto start = std::chrono::steady_clock::now();
     const sim::SimulationRun run(config);
     const std::string base = out.substr(0, out.size() - 4);
     writeText(base + ".target.yaml", sim::targetYaml(config.target));
     writeText(base + ".truth.yaml", sim::truthYaml(run));
-    const int rendered = writeBag(run, out, compression);
+    const int rendered = writeBag(run, out, bag_options);
     const double secs =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::cout << "simulate_bag: wrote " << out << " (" << run.trajectory.duration() << " s, "

@@ -11,8 +11,8 @@
 //   non_finite       a camera_pose orientation that is not a unit quaternion
 // Frame ids are kept without a leading slash (tf2 refuses "/imu"). A magnetometer whose frame_id
 // differs from the IMU's is rotated into the IMU frame when the caller knows the rotation
-// (setMagnetometerRotation, e.g. from tf), and otherwise assumed to share the IMU's axes, with a
-// notice.
+// (setMagnetometerRotation, or looked up in tf: setTransforms), and otherwise assumed to share the
+// IMU's axes, with a notice.
 #pragma once
 
 #include <geometry_msgs/PoseStamped.h>
@@ -21,8 +21,10 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/MagneticField.h>
+#include <tf2/buffer_core.h>
 
 #include <Eigen/Core>
+#include <chrono>
 #include <functional>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -63,8 +65,12 @@ class MessageInput {
   void setMagnetometerRotation(const Eigen::Matrix3d& R_imu_mag);
   bool hasMagnetometerRotation() const { return R_imu_mag_.has_value(); }
   /// True when the magnetometer's frame_id differs from the IMU's (both seen) and no rotation is
-  /// set: the caller may look one up.
+  /// set for these two frames (a changed frame id drops the old one): the caller may look one up.
   bool needsMagnetometerRotation() const;
+  /// Where R_imu_mag is looked up (latest transform magnetometer frame -> IMU frame) when the two
+  /// frames differ: at the first magnetometer message of a new pair of frames, then at most once a
+  /// second until found (a notice says when). `tf` must outlive this object; nullptr: never.
+  void setTransforms(const tf2::BufferCore* tf);
 
   /// The latest frame id of each input (camera: the images'), without a leading slash ("" before
   /// the first).
@@ -77,12 +83,15 @@ class MessageInput {
                    cv::Mat grey, bool feed, cv::Mat* mono8);
   void noteFrame(const std::string& frame_id, std::string* kept, const char* input);
   void checkMagFrame();
+  void lookUpMagnetometerRotation();
 
   CalibrationPipeline* pipeline_;
   std::function<void(const std::string&)> notice_;
   std::string imu_frame_, mag_frame_, camera_frame_;
   std::string noted_frame_pair_;  ///< IMU and magnetometer frames last noted as different
   std::optional<Eigen::Matrix3d> R_imu_mag_;
+  const tf2::BufferCore* tf_ = nullptr;
+  std::chrono::steady_clock::time_point last_lookup_;   ///< of R_imu_mag (throttled)
   std::optional<sensor_msgs::CameraInfo> info_in_use_;  ///< the last accepted camera info
 };
 
