@@ -353,6 +353,34 @@ TEST_F(AlignmentRos, RealImuOnlyBagsKeepItWaitingForTheCameraWithoutATf) {
   EXPECT_NE(log.find("'magnetometer'"), std::string::npos) << log;
 }
 
+TEST_F(AlignmentRos, ACorruptSavedFileIsSetAsideAndTheNodeStartsFresh) {
+  // A truncated result file (a power cut while an older version wrote it) at start: a warning,
+  // the file kept as .bad for the user, no tf from it, the node waiting for data.
+  const std::string saved = temp("corrupt_result.yaml");
+  std::filesystem::remove(saved + ".bad");
+  {
+    std::ofstream out(saved);
+    out << "R_cam_imu:\n  rows: 3\n  cols: 3\n  data: [0.9, 0.1,";
+  }
+  ExtraNode node("corrupt", "_output_file:=" + saved +
+                                " _camera_frame:=corrupt_cam _imu_frame:=corrupt_imu" +
+                                remapsUnder("corrupt"));
+  ASSERT_TRUE(node.started());
+  const auto status = waitForStatus(
+      30.0, [](const AlignmentStatus&) { return true; }, "/corrupt");
+  ASSERT_TRUE(status) << node.log();
+  EXPECT_EQ(status->state, AlignmentStatus::WAITING_FOR_DATA) << status->message;
+  EXPECT_FALSE(status->has_estimate);
+  EXPECT_TRUE(node.alive());
+  node.stop();
+  const std::string log = node.log();
+  EXPECT_NE(log.find("saved calibration not loaded"), std::string::npos) << log;
+  EXPECT_NE(log.find(saved + ".bad"), std::string::npos) << log;
+  EXPECT_TRUE(std::filesystem::exists(saved + ".bad"));
+  EXPECT_FALSE(std::filesystem::exists(saved));
+  EXPECT_FALSE(buffer_.canTransform("corrupt_cam", "corrupt_imu", ros::Time(0)));
+}
+
 TEST_F(AlignmentRos, HostileInputsAreCountedByReasonAndNothingBreaks) {
   // Every kind of bad message, sent to a node of its own; each is refused, counted under its
   // reason in /diagnostics and warned about naming the topic; the node keeps running.
