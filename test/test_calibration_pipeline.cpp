@@ -296,10 +296,19 @@ TEST(CalibrationPipeline, ATargetPartlyOrNotInViewIsCountedAndGivesNoPose) {
     test::Injection injection;
     injection.cover_fraction = covered;
     PipelineSettings settings;
-    settings.min_frame_interval_s = 0.5;  // fewer (slow) failing detections
+    settings.min_frame_interval_s = 0.15;
+    settings.missed_frame_interval_s = 1.0;
     const auto r = test::runPipeline(c, settings, injection);
     EXPECT_EQ(r.pipeline->posesTotal(), 0u) << covered;
-    EXPECT_GT(r.pipeline->framesDetected(), 0u) << covered;
+    // After 3 misses in a row at a rest, one attempt per missed_frame_interval_s (a miss costs
+    // up to 15x a hit); at min_frame_interval_s a 4 s rest would cost about 25 attempts.
+    ASSERT_EQ(r.pipeline->segments().size(), 2u) << covered;
+    double most_attempts = 0.0;
+    for (const StationarySegment& rest : r.pipeline->segments()) {
+      most_attempts += 3 + 1.0 + rest.duration() / 1.0;  // 3: kMissesBeforeBackoff
+    }
+    EXPECT_GE(r.pipeline->framesDetected(), 2u * 3u) << covered;
+    EXPECT_LE(r.pipeline->framesDetected(), most_attempts) << covered;
     // Every detection attempt at rest failed and was counted; none was taken for a pose.
     EXPECT_EQ(r.pipeline->rejections().count(RejectReason::kTargetNotFound),
               r.pipeline->framesDetected())

@@ -43,6 +43,7 @@ PipelineSettings scrambled() {
   s.min_frames_per_pose = 7;
   s.max_frames_per_pose = 77;
   s.min_frame_interval_s = 7;
+  s.missed_frame_interval_s = 17;
   s.frame_margin_s = 7;
   s.max_camera_spread_deg = 7;
   s.frame_queue_s = 7;
@@ -80,6 +81,7 @@ void expectDefaults(const PipelineSettings& s) {
   EXPECT_EQ(s.min_frames_per_pose, d.min_frames_per_pose);
   EXPECT_EQ(s.max_frames_per_pose, d.max_frames_per_pose);
   EXPECT_EQ(s.min_frame_interval_s, d.min_frame_interval_s);
+  EXPECT_EQ(s.missed_frame_interval_s, d.missed_frame_interval_s);
   EXPECT_EQ(s.frame_margin_s, d.frame_margin_s);
   EXPECT_EQ(s.max_camera_spread_deg, d.max_camera_spread_deg);
   EXPECT_EQ(s.frame_queue_s, d.frame_queue_s);

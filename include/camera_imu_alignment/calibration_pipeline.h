@@ -83,6 +83,10 @@ struct PipelineSettings {
   int min_frames_per_pose = 2;         ///< camera frames with a pose needed for a stationary pose
   int max_frames_per_pose = 10;        ///< detection stops after this many good frames per rest
   double min_frame_interval_s = 0.15;  ///< frames closer than this to the last detected one skipped
+  /// After kMissesBeforeBackoff failed detections in a row at one rest (target out of view, a
+  /// miss costs up to 15x a hit), frames closer than this to the last attempt are skipped.
+  double missed_frame_interval_s = 1.0;
+  static constexpr int kMissesBeforeBackoff = 3;
   double frame_margin_s = 0.15;        ///< see "Time offsets" above
   double max_camera_spread_deg = 0.5;  ///< camera orientation scatter within a pose
   double max_gyro_span_s = 120.0;      ///< longer motion between poses breaks the gyro chain

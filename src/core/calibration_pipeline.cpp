@@ -90,6 +90,10 @@ std::string PipelineSettings::validate() const {
     out << "frame_margin_s = " << frame_margin_s << ": must be >= 0";
   } else if (!(min_frame_interval_s >= 0.0 && std::isfinite(min_frame_interval_s))) {
     out << "min_frame_interval_s = " << min_frame_interval_s << ": must be >= 0";
+  } else if (!(missed_frame_interval_s >= min_frame_interval_s &&
+               std::isfinite(missed_frame_interval_s))) {
+    out << "missed_frame_interval_s = " << missed_frame_interval_s
+        << ": must be finite and >= min_frame_interval_s";
   } else if (window_poses < 2 || window_poses > 200) {
     out << "window_poses = " << window_poses << ": must be within [2, 200]";
   } else if (min_poses_to_solve < 2 ||
@@ -278,8 +282,15 @@ void CalibrationPipeline::Impl::processFrames(bool flush) {
 
 void CalibrationPipeline::Impl::processFrame(const CameraFrame& frame) {
   // Detection is the expensive part: only a few, spaced frames per rest.
-  if (frame.stamp_s - last_detection_stamp < settings.min_frame_interval_s) return;
   const std::optional<double> rest_since = stationary.restSince();
+  if (rest_since != misses_rest) {  // a new rest: the target may be in view again
+    misses_rest = rest_since;
+    misses_in_a_row = 0;
+  }
+  const double interval = misses_in_a_row >= PipelineSettings::kMissesBeforeBackoff
+                              ? settings.missed_frame_interval_s
+                              : settings.min_frame_interval_s;
+  if (frame.stamp_s - last_detection_stamp < interval) return;
   int in_this_rest = 0;
   for (const auto& d : detections) in_this_rest += (rest_since && d.stamp_s >= *rest_since);
   if (in_this_rest >= settings.max_frames_per_pose) return;
@@ -306,6 +317,7 @@ void CalibrationPipeline::Impl::processFrame(const CameraFrame& frame) {
   const Eigen::Matrix3d* hint = poses.empty() ? nullptr : &poses.back().R_target_cam;
   TargetObservation observation;
   if (!detector.detect(frame.mono8, &observation, hint)) {
+    ++misses_in_a_row;
     std::ostringstream out;
     out << "image at " << frame.stamp_s << " s (at rest): " << target.describe() << " not found";
     reject(RejectReason::kTargetNotFound, InputStream::kImage, out.str());
@@ -318,6 +330,7 @@ void CalibrationPipeline::Impl::processFrame(const CameraFrame& frame) {
            "image at " + std::to_string(frame.stamp_s) + " s: " + why);
     return;
   }
+  misses_in_a_row = 0;
   detections.push_back({frame.stamp_s, *pose});
 }
 

@@ -42,6 +42,8 @@ struct CalibrationPipeline::Impl {
   std::deque<CameraFrame> frame_queue;     ///< waiting until the IMU shows rest or motion
   std::vector<FrameDetection> detections;  ///< frames at rest with a camera pose
   double last_detection_stamp = -std::numeric_limits<double>::infinity();
+  int misses_in_a_row = 0;            ///< failed detections in a row at the rest misses_rest
+  std::optional<double> misses_rest;  ///< start of the rest they belong to
   std::uint64_t num_imu = 0, num_mag = 0, num_frames = 0, num_detected = 0;
   std::uint64_t frames_without_intrinsics = 0, frames_dropped = 0;
 

@@ -80,6 +80,8 @@ const std::vector<Key>& keys() {
       number<int>("min_frames_per_pose", [](auto* s) { return &s->min_frames_per_pose; }),
       number<int>("max_frames_per_pose", [](auto* s) { return &s->max_frames_per_pose; }),
       number<double>("min_frame_interval_s", [](auto* s) { return &s->min_frame_interval_s; }),
+      number<double>("missed_frame_interval_s",
+                     [](auto* s) { return &s->missed_frame_interval_s; }),
       number<double>("frame_margin_s", [](auto* s) { return &s->frame_margin_s; }),
       number<double>("max_camera_spread_deg", [](auto* s) { return &s->max_camera_spread_deg; }),
       number<double>("frame_queue_s", [](auto* s) { return &s->frame_queue_s; }),
