@@ -10,6 +10,7 @@
 #include <limits>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
+#include <thread>
 #include <vector>
 
 #include "camera_imu_alignment/ros/clock_jump.h"
@@ -397,6 +398,47 @@ TEST(MessageInput, AMagnetometerRotationIsLookedUpInTf) {
   EXPECT_NEAR(rad2deg(rotationAngle(truth.transpose() * unknown)), 30.0, 1e-6);
   ASSERT_FALSE(notices.empty());
   EXPECT_NE(notices.back().find("differs from the IMU's"), std::string::npos) << notices.back();
+}
+
+TEST(MessageInput, MagnetometerSamplesWaitForTheirRotationAShortWhile) {
+  // A live tf listener has just started: samples are held back (not fed, not counted) until the
+  // rotation is known or the grace period is over; then the IMU's axes are assumed, with a notice.
+  const auto sleep = [](int ms) { std::this_thread::sleep_for(std::chrono::milliseconds(ms)); };
+  sensor_msgs::MagneticField mag = magAt(1.0);
+  mag.header.frame_id = "mag";
+  tf2::BufferCore tf;
+  Boundary arrives;
+  arrives.input->setTransforms(&tf, std::chrono::milliseconds(400));
+  arrives.input->addImu(imuAt(1.0));
+  arrives.input->addMagnetic(mag);
+  EXPECT_EQ(arrives.pipeline->magneticSamples(), 0u);
+  geometry_msgs::TransformStamped t;
+  t.header.frame_id = "imu_link";
+  t.child_frame_id = "mag";
+  t.transform.rotation.w = 1.0;
+  ASSERT_TRUE(tf.setTransform(t, "test", true));
+  sleep(150);  // retried every 0.1 s during the grace period
+  mag.header.stamp = ros::Time(1.1);
+  arrives.input->addMagnetic(mag);
+  EXPECT_EQ(arrives.pipeline->magneticSamples(), 1u);
+  EXPECT_TRUE(arrives.input->hasMagnetometerRotation());
+  EXPECT_TRUE(arrives.rejects.empty());
+
+  tf2::BufferCore empty;
+  Boundary never;
+  never.input->setTransforms(&empty, std::chrono::milliseconds(200));
+  never.input->addImu(imuAt(1.0));
+  mag.header.stamp = ros::Time(1.0);
+  never.input->addMagnetic(mag);
+  EXPECT_EQ(never.pipeline->magneticSamples(), 0u);
+  EXPECT_TRUE(never.notices.empty());
+  sleep(250);
+  mag.header.stamp = ros::Time(1.1);
+  never.input->addMagnetic(mag);
+  EXPECT_EQ(never.pipeline->magneticSamples(), 1u);
+  EXPECT_FALSE(never.input->hasMagnetometerRotation());
+  ASSERT_FALSE(never.notices.empty());
+  EXPECT_NE(never.notices.back().find("differs from the IMU's"), std::string::npos);
 }
 
 TEST(MessageInput, ARotationFoundForOtherFramesIsDropped) {

@@ -122,7 +122,7 @@ void AlignmentWrapper::Impl::onMag(const sensor_msgs::MagneticFieldConstPtr& msg
     // The magnetometer has a frame of its own: its rotation into the IMU frame comes from tf.
     tf_buffer = std::make_unique<tf2_ros::Buffer>();
     tf_listener = std::make_unique<tf2_ros::TransformListener>(*tf_buffer, nh);
-    input->setTransforms(tf_buffer.get());
+    input->setTransforms(tf_buffer.get(), std::chrono::seconds(1));  // tf arriving
   }
   input->addMagnetic(*msg);
   applyPendingReset();

@@ -35,6 +35,7 @@ void MessageInput::noteFrame(const std::string& frame_id, std::string* kept, con
   if (!kept->empty() && kept != &camera_frame_) {  // a rotation found for other frames is void
     R_imu_mag_.reset();
     last_lookup_ = std::chrono::steady_clock::time_point{};
+    waiting_since_.reset();
   }
   *kept = normalized;
   if (normalized != frame_id && notice_) {
@@ -49,7 +50,7 @@ bool MessageInput::needsMagnetometerRotation() const {
 
 void MessageInput::checkMagFrame() {
   const std::string pair = imu_frame_ + "\n" + mag_frame_;
-  if (pair == noted_frame_pair_ || !needsMagnetometerRotation()) return;
+  if (pair == noted_frame_pair_ || !needsMagnetometerRotation() || waitingForRotation()) return;
   noted_frame_pair_ = pair;
   if (notice_) {
     notice_("the magnetometer's frame_id '" + mag_frame_ + "' differs from the IMU's '" +
@@ -63,15 +64,25 @@ void MessageInput::setMagnetometerRotation(const Eigen::Matrix3d& R_imu_mag) {
   R_imu_mag_ = R_imu_mag;
 }
 
-void MessageInput::setTransforms(const tf2::BufferCore* tf) {
+void MessageInput::setTransforms(const tf2::BufferCore* tf, std::chrono::milliseconds grace) {
   tf_ = tf;
+  grace_ = grace;
   last_lookup_ = std::chrono::steady_clock::time_point{};
+  waiting_since_.reset();
+}
+
+bool MessageInput::waitingForRotation() const {
+  return tf_ && needsMagnetometerRotation() && waiting_since_ &&
+         std::chrono::steady_clock::now() - *waiting_since_ < grace_;
 }
 
 void MessageInput::lookUpMagnetometerRotation() {
   if (!tf_ || !needsMagnetometerRotation()) return;
   const auto now = std::chrono::steady_clock::now();
-  if (now - last_lookup_ < std::chrono::seconds(1)) return;
+  if (!waiting_since_) waiting_since_ = now;
+  const auto retry = now - *waiting_since_ < grace_ ? std::chrono::milliseconds(100)
+                                                    : std::chrono::milliseconds(1000);
+  if (now - last_lookup_ < retry) return;
   last_lookup_ = now;
   geometry_msgs::TransformStamped t;
   try {
@@ -101,6 +112,7 @@ void MessageInput::addMagnetic(const sensor_msgs::MagneticField& msg) {
   if (!checkStamp(msg.header, InputStream::kMagnetometer)) return;
   noteFrame(msg.header.frame_id, &mag_frame_, "the magnetometer's");
   lookUpMagnetometerRotation();
+  if (waitingForRotation()) return;  // not in the IMU's axes yet: held back, not counted
   checkMagFrame();
   MagneticSample sample = toMagneticSample(msg);
   if (R_imu_mag_) sample.field_t = *R_imu_mag_ * sample.field_t;

@@ -68,9 +68,12 @@ class MessageInput {
   /// set for these two frames (a changed frame id drops the old one): the caller may look one up.
   bool needsMagnetometerRotation() const;
   /// Where R_imu_mag is looked up (latest transform magnetometer frame -> IMU frame) when the two
-  /// frames differ: at the first magnetometer message of a new pair of frames, then at most once a
-  /// second until found (a notice says when). `tf` must outlive this object; nullptr: never.
-  void setTransforms(const tf2::BufferCore* tf);
+  /// frames differ: from the first magnetometer message of a new pair of frames, every 0.1 s for
+  /// `grace` of wall time, its samples dropped meanwhile (a live tf listener may still be
+  /// receiving /tf_static; 0 when `tf` is complete, as a bag's), then at most once a second with
+  /// the IMU's axes assumed (a notice says which). `tf` must outlive this object; nullptr: never.
+  void setTransforms(const tf2::BufferCore* tf,
+                     std::chrono::milliseconds grace = std::chrono::milliseconds(0));
 
   /// The latest frame id of each input (camera: the images'), without a leading slash ("" before
   /// the first).
@@ -84,6 +87,7 @@ class MessageInput {
   void noteFrame(const std::string& frame_id, std::string* kept, const char* input);
   void checkMagFrame();
   void lookUpMagnetometerRotation();
+  bool waitingForRotation() const;
 
   CalibrationPipeline* pipeline_;
   std::function<void(const std::string&)> notice_;
@@ -91,7 +95,9 @@ class MessageInput {
   std::string noted_frame_pair_;  ///< IMU and magnetometer frames last noted as different
   std::optional<Eigen::Matrix3d> R_imu_mag_;
   const tf2::BufferCore* tf_ = nullptr;
-  std::chrono::steady_clock::time_point last_lookup_;   ///< of R_imu_mag (throttled)
+  std::chrono::milliseconds grace_{0};                 ///< see setTransforms
+  std::chrono::steady_clock::time_point last_lookup_;  ///< of R_imu_mag (throttled)
+  std::optional<std::chrono::steady_clock::time_point> waiting_since_;  ///< first needed
   std::optional<sensor_msgs::CameraInfo> info_in_use_;  ///< the last accepted camera info
 };
 
