@@ -3,6 +3,8 @@
 // map to the intrinsics.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -156,6 +158,27 @@ TEST(MessageConversion, ImuAndMagneticFieldKeepStampsAndAxes) {
   const MagneticSample field = toMagneticSample(mag);
   EXPECT_EQ(field.stamp_s, 5.0);
   EXPECT_EQ(field.field_t, Eigen::Vector3d(0.0, 22e-6, 0.0));
+}
+
+TEST(MessageConversion, QuaternionsToRotationsAndBack) {
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1.0, -2.0, 0.5).normalized()).toRotationMatrix();
+  const geometry_msgs::Quaternion q = toQuaternionMsg(R);
+  EXPECT_NEAR(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w, 1.0, 1e-12);
+  const std::optional<Eigen::Matrix3d> back = toRotation(q);
+  ASSERT_TRUE(back);
+  EXPECT_LT((*back - R).norm(), 1e-12);
+  geometry_msgs::Quaternion almost = q;  // a float-precision quaternion is renormalised
+  almost.w *= 1.0 + 5e-4;
+  ASSERT_TRUE(toRotation(almost));
+  EXPECT_LT(((*toRotation(almost)).transpose() * *toRotation(almost) - Eigen::Matrix3d::Identity())
+                .norm(),
+            1e-12);
+  geometry_msgs::Quaternion zero;  // all zeros, as a driver that never set it
+  geometry_msgs::Quaternion twice = q, nan = q;
+  twice.x *= 2.0, twice.y *= 2.0, twice.z *= 2.0, twice.w *= 2.0;
+  nan.y = std::numeric_limits<double>::quiet_NaN();
+  for (const auto& bad : {zero, twice, nan}) EXPECT_FALSE(toRotation(bad));
 }
 
 }  // namespace

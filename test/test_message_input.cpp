@@ -378,10 +378,7 @@ TEST(MessageInput, AMagnetometerRotationIsLookedUpInTf) {
   geometry_msgs::TransformStamped t;
   t.header.frame_id = "imu_link";
   t.child_frame_id = "mag";
-  t.transform.rotation.x = q_imu_mag.x();
-  t.transform.rotation.y = q_imu_mag.y();
-  t.transform.rotation.z = q_imu_mag.z();
-  t.transform.rotation.w = q_imu_mag.w();
+  t.transform.rotation = toQuaternionMsg(q_imu_mag.toRotationMatrix());
   ASSERT_TRUE(tf.setTransform(t, "test", true));
   const Eigen::Vector3d field_imu(2e-5, 0.0, -4e-5);
   const Eigen::Vector3d field_mag = q_imu_mag.conjugate() * field_imu;

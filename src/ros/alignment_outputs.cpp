@@ -16,19 +16,10 @@
 #include "camera_imu_alignment/csv_io.h"
 #include "camera_imu_alignment/result_yaml.h"
 #include "camera_imu_alignment/ros/broadcast_gate.h"
+#include "camera_imu_alignment/ros/message_conversion.h"
 #include "camera_imu_alignment/rotation_math.h"
 
 namespace camera_imu_alignment {
-namespace {
-
-geometry_msgs::Quaternion toMsg(const Eigen::Matrix3d& R) {
-  const Eigen::Quaterniond q(R);
-  geometry_msgs::Quaternion out;
-  out.x = q.x(), out.y = q.y(), out.z = q.z(), out.w = q.w();
-  return out;
-}
-
-}  // namespace
 
 void AlignmentWrapper::Impl::advertise() {
   status_pub = pnh.advertise<AlignmentStatus>("status", 10, true);
@@ -104,11 +95,11 @@ void AlignmentWrapper::Impl::broadcast(const Eigen::Matrix3d& R_cam_imu, double 
   if (settings.publish_inverse) {
     t.header.frame_id = imuFrame();
     t.child_frame_id = cameraFrame();
-    t.transform.rotation = toMsg(R_cam_imu.transpose());
+    t.transform.rotation = toQuaternionMsg(R_cam_imu.transpose());
   } else {
     t.header.frame_id = cameraFrame();
     t.child_frame_id = imuFrame();
-    t.transform.rotation = toMsg(R_cam_imu);
+    t.transform.rotation = toQuaternionMsg(R_cam_imu);
   }
   broadcaster.sendTransform(t);
   broadcast_R = R_cam_imu;
@@ -171,7 +162,7 @@ void AlignmentWrapper::Impl::publishStatus() {
     s.pairs = static_cast<std::uint32_t>(r->quality.num_pairs);
     s.inliers = static_cast<std::uint32_t>(r->quality.num_inliers);
     s.has_estimate = true;
-    s.q_cam_imu = toMsg(r->R_cam_imu);
+    s.q_cam_imu = toQuaternionMsg(r->R_cam_imu);
     s.residual_rms_deg = r->quality.residual_rms_deg;
     for (int i = 0; i < 3; ++i) s.std_dev_deg[i] = r->quality.std_dev_deg(i);
     s.observability = r->quality.observability;
@@ -204,7 +195,7 @@ void AlignmentWrapper::Impl::publishPoses() {
     pose.position.x = p.p_target_cam.x();
     pose.position.y = p.p_target_cam.y();
     pose.position.z = p.p_target_cam.z();
-    pose.orientation = toMsg(p.R_target_cam);
+    pose.orientation = toQuaternionMsg(p.R_target_cam);
     out.poses.push_back(pose);
   }
   poses_pub.publish(out);
@@ -218,7 +209,7 @@ void AlignmentWrapper::Impl::publishPoses() {
   target.pose.position.x = p_cam_target.x();
   target.pose.position.y = p_cam_target.y();
   target.pose.position.z = p_cam_target.z();
-  target.pose.orientation = toMsg(last.R_target_cam.transpose());
+  target.pose.orientation = toQuaternionMsg(last.R_target_cam.transpose());
   target_pose_pub.publish(target);
   // The same as a tf frame, so that rviz can show camera, IMU and target together.
   geometry_msgs::TransformStamped t;
@@ -267,7 +258,7 @@ bool AlignmentWrapper::Impl::onCalibrate(Calibrate::Request&, Calibrate::Respons
   res.success = r.status == SolveStatus::kOk;
   res.message = r.message;
   if (r.status != SolveStatus::kBadInput) {
-    res.q_cam_imu = toMsg(r.R_cam_imu);
+    res.q_cam_imu = toQuaternionMsg(r.R_cam_imu);
     const Eigen::Vector3d rpy = rollPitchYawDeg(r.R_cam_imu);
     for (int i = 0; i < 3; ++i) {
       res.rpy_deg[i] = rpy(i);

@@ -1,5 +1,6 @@
 #include "camera_imu_alignment/ros/message_conversion.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -22,6 +23,20 @@ ImuSample toImuSample(const sensor_msgs::Imu& msg) {
     sample.q_world_imu = Eigen::Quaterniond(q.w, q.x, q.y, q.z);  // the pipeline checks the norm
   }
   return sample;
+}
+
+std::optional<Eigen::Matrix3d> toRotation(const geometry_msgs::Quaternion& q) {
+  const Eigen::Quaterniond quat(q.w, q.x, q.y, q.z);
+  const double norm = quat.norm();
+  if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-3) return std::nullopt;
+  return quat.normalized().toRotationMatrix();
+}
+
+geometry_msgs::Quaternion toQuaternionMsg(const Eigen::Matrix3d& R) {
+  const Eigen::Quaterniond q(R);
+  geometry_msgs::Quaternion out;
+  out.x = q.x(), out.y = q.y(), out.z = q.z(), out.w = q.w();
+  return out;
 }
 
 MagneticSample toMagneticSample(const sensor_msgs::MagneticField& msg) {

@@ -3,7 +3,6 @@
 
 #include <tf2/exceptions.h>
 
-#include <Eigen/Geometry>
 #include <cmath>
 #include <sstream>
 
@@ -90,10 +89,9 @@ void MessageInput::lookUpMagnetometerRotation() {
   } catch (const tf2::TransformException&) {
     return;  // not (yet) known
   }
-  const auto& r = t.transform.rotation;
-  const Eigen::Quaterniond q_imu_mag(r.w, r.x, r.y, r.z);
-  if (!std::isfinite(q_imu_mag.norm()) || std::abs(q_imu_mag.norm() - 1.0) > 1e-3) return;
-  setMagnetometerRotation(q_imu_mag.normalized().toRotationMatrix());
+  const std::optional<Eigen::Matrix3d> R_imu_mag = toRotation(t.transform.rotation);
+  if (!R_imu_mag) return;  // not a rotation: as if unknown
+  setMagnetometerRotation(*R_imu_mag);
   if (notice_) {
     notice_("the magnetometer's field is rotated from '" + mag_frame_ + "' into '" + imu_frame_ +
             "' (tf)");
@@ -187,8 +185,9 @@ bool MessageInput::finishImage(const std_msgs::Header& header, bool converted,
 bool MessageInput::addCameraPose(const geometry_msgs::PoseStamped& msg, bool feed) {
   if (!checkStamp(msg.header, InputStream::kCameraPose)) return false;
   const auto& q = msg.pose.orientation;
-  const double norm = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
-  if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-3) {
+  const std::optional<Eigen::Matrix3d> R_target_cam = toRotation(q);
+  if (!R_target_cam) {
+    const double norm = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
     std::ostringstream out;
     out << "orientation is not a unit quaternion (norm " << norm << "); pose dropped";
     pipeline_->rejectInput(RejectReason::kNonFinite, InputStream::kCameraPose, out.str());
@@ -197,7 +196,7 @@ bool MessageInput::addCameraPose(const geometry_msgs::PoseStamped& msg, bool fee
   if (!feed) return true;
   CameraFrame frame;
   frame.stamp_s = msg.header.stamp.toSec();
-  frame.R_target_cam = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized().toRotationMatrix();
+  frame.R_target_cam = *R_target_cam;
   pipeline_->addFrame(frame);
   return true;
 }

@@ -3,13 +3,16 @@
 // Nothing here validates values (NaN, zero vectors, stamps): the pipeline does, and counts.
 #pragma once
 
+#include <geometry_msgs/Quaternion.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/MagneticField.h>
 
+#include <Eigen/Core>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 
 #include "camera_imu_alignment/camera_model.h"
@@ -29,6 +32,11 @@ bool toCameraIntrinsics(const sensor_msgs::CameraInfo& msg, CameraIntrinsics* in
 /// too), rgb8, bgr8, rgba8, bgra8 (to grey). False with `error` for other encodings or when
 /// step/size/data length disagree.
 bool toMono8(const sensor_msgs::Image& msg, cv::Mat* mono8, std::string* error);
+/// The rotation of a unit quaternion (norm within 1e-3 of 1, renormalised); nullopt for anything
+/// else (NaN, zero, unnormalised), which callers count as non_finite.
+std::optional<Eigen::Matrix3d> toRotation(const geometry_msgs::Quaternion& q);
+/// A rotation matrix as a quaternion message.
+geometry_msgs::Quaternion toQuaternionMsg(const Eigen::Matrix3d& R);
 /// JPEG/PNG payload of a CompressedImage (any format cv::imdecode reads), decoded to grey.
 bool toMono8(const sensor_msgs::CompressedImage& msg, cv::Mat* mono8, std::string* error);
 
