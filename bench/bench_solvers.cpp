@@ -24,10 +24,10 @@
 #include <opencv2/core/eigen.hpp>
 #include <random>
 
-#include "camera_imu_alignment/alignment_solver.h"
-#include "camera_imu_alignment/example_data.h"
-#include "camera_imu_alignment/pose_window.h"
-#include "camera_imu_alignment/rotation_math.h"
+#include "camera_imu_alignment/solver/alignment_solver.h"
+#include "camera_imu_alignment/solver/example_data.h"
+#include "camera_imu_alignment/solver/pose_window.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace cia = camera_imu_alignment;
 

@@ -2,8 +2,8 @@
 // crash, a hang or undefined behaviour; rows read must hold finite rotations.
 #include <cstdint>
 
-#include "camera_imu_alignment/csv_io.h"
-#include "camera_imu_alignment/rotation_math.h"
+#include "camera_imu_alignment/io/csv_io.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 #include "fuzz_common.h"
 
 namespace cia = camera_imu_alignment;

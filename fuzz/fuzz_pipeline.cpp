@@ -6,8 +6,8 @@
 #include <cstring>
 #include <opencv2/core.hpp>
 
-#include "camera_imu_alignment/calibration_pipeline.h"
-#include "camera_imu_alignment/target_description.h"
+#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/vision/target_description.h"
 
 namespace cia = camera_imu_alignment;
 

@@ -4,11 +4,11 @@
 #include <cstdint>
 #include <string>
 
-#include "camera_imu_alignment/csv_io.h"
-#include "camera_imu_alignment/pipeline_config.h"
-#include "camera_imu_alignment/result_yaml.h"
-#include "camera_imu_alignment/rotation_math.h"
-#include "camera_imu_alignment/target_description.h"
+#include "camera_imu_alignment/io/input_error.h"
+#include "camera_imu_alignment/pipeline/pipeline_config.h"
+#include "camera_imu_alignment/io/result_yaml.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
+#include "camera_imu_alignment/vision/target_description.h"
 #include "fuzz_common.h"
 
 namespace cia = camera_imu_alignment;

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "camera_imu_alignment/inertial_samples.h"
+#include "camera_imu_alignment/inertial/inertial_samples.h"
 
 #ifndef CIA_REALDATA_DIR
 #define CIA_REALDATA_DIR "/work/shared/realdata"

@@ -7,11 +7,11 @@
 #include <memory>
 #include <vector>
 
-#include "camera_imu_alignment/calibration_pipeline.h"
+#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
 #include "camera_imu_alignment/simulation/renderer.h"
 #include "camera_imu_alignment/simulation/simulation_run.h"
 #include "camera_imu_alignment/simulation/target.h"
-#include "camera_imu_alignment/target_description.h"
+#include "camera_imu_alignment/vision/target_description.h"
 
 namespace camera_imu_alignment {
 namespace test {

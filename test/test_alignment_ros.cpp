@@ -28,8 +28,8 @@
 
 #include "camera_imu_alignment/AlignmentStatus.h"
 #include "camera_imu_alignment/Calibrate.h"
-#include "camera_imu_alignment/result_yaml.h"
-#include "camera_imu_alignment/rotation_math.h"
+#include "camera_imu_alignment/io/result_yaml.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 #include "test_helpers.h"
 #include "tool_runner.h"
 

@@ -6,7 +6,7 @@
 #include <limits>
 
 #include "camera_imu_alignment/ros/broadcast_gate.h"
-#include "camera_imu_alignment/rotation_math.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {
 namespace {

@@ -7,8 +7,8 @@
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 
-#include "camera_imu_alignment/result_yaml.h"
-#include "camera_imu_alignment/rotation_math.h"
+#include "camera_imu_alignment/io/result_yaml.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 #include "tool_runner.h"
 
 namespace camera_imu_alignment {

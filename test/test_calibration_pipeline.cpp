@@ -8,7 +8,7 @@
 #include <limits>
 #include <random>
 
-#include "camera_imu_alignment/rotation_math.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 #include "pipeline_simulation.h"
 #include "test_helpers.h"
 

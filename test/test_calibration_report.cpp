@@ -1,7 +1,7 @@
 // The calibration report: roll/pitch/yaw against analytic rotations, the export blocks parsed back
 // (Kalibr, OpenVINS, VINS, tf2) to 1e-8, the summary text, and the PNG page for realistic, empty
 // and NaN inputs.
-#include "camera_imu_alignment/calibration_report.h"
+#include "camera_imu_alignment/io/calibration_report.h"
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "camera_imu_alignment/pose_window.h"
+#include "camera_imu_alignment/solver/pose_window.h"
 #include "test_helpers.h"
 
 namespace camera_imu_alignment {

@@ -12,9 +12,9 @@
 #include <functional>
 #include <sstream>
 
-#include "camera_imu_alignment/csv_io.h"
-#include "camera_imu_alignment/result_yaml.h"
-#include "camera_imu_alignment/rotation_math.h"
+#include "camera_imu_alignment/io/csv_io.h"
+#include "camera_imu_alignment/io/result_yaml.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 #include "test_helpers.h"
 
 namespace camera_imu_alignment {

@@ -11,7 +11,7 @@
 #include <random>
 #include <string>
 
-#include "camera_imu_alignment/rotation_pair.h"
+#include "camera_imu_alignment/solver/rotation_pair.h"
 
 namespace camera_imu_alignment {
 namespace test {

@@ -9,10 +9,10 @@
 #include <random>
 
 #include "broad_csv.h"
-#include "camera_imu_alignment/imu_attitude.h"
-#include "camera_imu_alignment/magnetometer.h"
-#include "camera_imu_alignment/rotation_math.h"
-#include "camera_imu_alignment/stationary_detector.h"
+#include "camera_imu_alignment/inertial/imu_attitude.h"
+#include "camera_imu_alignment/inertial/magnetometer.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
+#include "camera_imu_alignment/inertial/stationary_detector.h"
 
 namespace camera_imu_alignment {
 namespace {

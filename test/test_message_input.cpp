@@ -16,8 +16,8 @@
 #include "camera_imu_alignment/ros/clock_jump.h"
 #include "camera_imu_alignment/ros/message_conversion.h"
 #include "camera_imu_alignment/ros/message_input.h"
-#include "camera_imu_alignment/rotation_math.h"
-#include "camera_imu_alignment/target_description.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
+#include "camera_imu_alignment/vision/target_description.h"
 
 namespace camera_imu_alignment {
 namespace {

@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "camera_imu_alignment/alignment_solver.h"
-#include "camera_imu_alignment/closed_form_solver.h"
+#include "camera_imu_alignment/solver/alignment_solver.h"
+#include "camera_imu_alignment/solver/closed_form_solver.h"
 #include "test_helpers.h"
 
 namespace camera_imu_alignment {

@@ -10,7 +10,7 @@
 
 #include <cmath>
 
-#include "camera_imu_alignment/alignment_solver.h"
+#include "camera_imu_alignment/solver/alignment_solver.h"
 #include "test_helpers.h"
 
 namespace camera_imu_alignment {

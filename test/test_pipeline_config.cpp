@@ -5,8 +5,8 @@
 #include <fstream>
 #include <set>
 
-#include "camera_imu_alignment/csv_io.h"
-#include "camera_imu_alignment/pipeline_config.h"
+#include "camera_imu_alignment/io/input_error.h"
+#include "camera_imu_alignment/pipeline/pipeline_config.h"
 #include "camera_imu_alignment/ros/wrapper_settings.h"
 #include "test_helpers.h"
 

@@ -6,8 +6,8 @@
 #include <set>
 #include <utility>
 
-#include "camera_imu_alignment/alignment_solver.h"
-#include "camera_imu_alignment/pose_window.h"
+#include "camera_imu_alignment/solver/alignment_solver.h"
+#include "camera_imu_alignment/solver/pose_window.h"
 #include "test_helpers.h"
 
 namespace camera_imu_alignment {

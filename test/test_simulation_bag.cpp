@@ -11,7 +11,7 @@
 #include <map>
 #include <string>
 
-#include "camera_imu_alignment/result_yaml.h"
+#include "camera_imu_alignment/io/result_yaml.h"
 
 namespace camera_imu_alignment {
 namespace {

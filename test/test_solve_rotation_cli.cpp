@@ -10,8 +10,8 @@
 #include <random>
 #include <regex>
 
-#include "camera_imu_alignment/csv_io.h"
-#include "camera_imu_alignment/result_yaml.h"
+#include "camera_imu_alignment/io/csv_io.h"
+#include "camera_imu_alignment/io/result_yaml.h"
 #include "test_helpers.h"
 
 namespace camera_imu_alignment {

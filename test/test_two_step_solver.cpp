@@ -3,8 +3,8 @@
 
 #include <Eigen/Dense>
 
-#include "camera_imu_alignment/alignment_solver.h"
-#include "camera_imu_alignment/two_step_solver.h"
+#include "camera_imu_alignment/solver/alignment_solver.h"
+#include "camera_imu_alignment/solver/two_step_solver.h"
 #include "test_helpers.h"
 
 namespace camera_imu_alignment {

@@ -12,12 +12,12 @@
 
 #include "alignment_wrapper_impl.h"
 #include "camera_imu_alignment/AlignmentStatus.h"
-#include "camera_imu_alignment/calibration_report.h"
-#include "camera_imu_alignment/csv_io.h"
-#include "camera_imu_alignment/result_yaml.h"
+#include "camera_imu_alignment/io/calibration_report.h"
+#include "camera_imu_alignment/io/input_error.h"
+#include "camera_imu_alignment/io/result_yaml.h"
 #include "camera_imu_alignment/ros/broadcast_gate.h"
 #include "camera_imu_alignment/ros/message_conversion.h"
-#include "camera_imu_alignment/rotation_math.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {
 

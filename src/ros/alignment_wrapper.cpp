@@ -5,10 +5,10 @@
 #include <cmath>
 
 #include "alignment_wrapper_impl.h"
-#include "camera_imu_alignment/csv_io.h"
+#include "camera_imu_alignment/io/input_error.h"
 #include "camera_imu_alignment/ros/message_conversion.h"
-#include "camera_imu_alignment/solution_quality.h"
-#include "camera_imu_alignment/target_description.h"
+#include "camera_imu_alignment/solver/solution_quality.h"
+#include "camera_imu_alignment/vision/target_description.h"
 
 namespace camera_imu_alignment {
 

@@ -21,13 +21,13 @@
 #include <optional>
 
 #include "camera_imu_alignment/Calibrate.h"
-#include "camera_imu_alignment/calibration_pipeline.h"
+#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
 #include "camera_imu_alignment/ros/alignment_wrapper.h"
 #include "camera_imu_alignment/ros/broadcast_gate.h"
 #include "camera_imu_alignment/ros/clock_jump.h"
 #include "camera_imu_alignment/ros/message_input.h"
 #include "camera_imu_alignment/ros/wrapper_settings.h"
-#include "camera_imu_alignment/target_detector.h"
+#include "camera_imu_alignment/vision/target_detector.h"
 
 namespace camera_imu_alignment {
 

@@ -2,7 +2,7 @@
 
 #include <sstream>
 
-#include "camera_imu_alignment/rotation_math.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {
 

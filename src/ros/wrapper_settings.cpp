@@ -8,8 +8,8 @@
 #include <functional>
 #include <sstream>
 
-#include "camera_imu_alignment/csv_io.h"
-#include "camera_imu_alignment/pipeline_config.h"
+#include "camera_imu_alignment/io/input_error.h"
+#include "camera_imu_alignment/pipeline/pipeline_config.h"
 
 namespace camera_imu_alignment {
 namespace {

@@ -8,7 +8,7 @@
 #include <set>
 #include <sstream>
 
-#include "camera_imu_alignment/rotation_math.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/simulation/target.h"
 
 namespace camera_imu_alignment {

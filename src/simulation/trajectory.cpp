@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "camera_imu_alignment/rotation_math.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/simulation/target.h"
 
 namespace camera_imu_alignment {

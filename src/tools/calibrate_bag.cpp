@@ -16,15 +16,15 @@
 #include <sstream>
 
 #include "bag_topics.h"
-#include "camera_imu_alignment/calibration_pipeline.h"
-#include "camera_imu_alignment/calibration_report.h"
-#include "camera_imu_alignment/csv_io.h"
-#include "camera_imu_alignment/pipeline_config.h"
-#include "camera_imu_alignment/result_yaml.h"
+#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/io/calibration_report.h"
+#include "camera_imu_alignment/io/input_error.h"
+#include "camera_imu_alignment/pipeline/pipeline_config.h"
+#include "camera_imu_alignment/io/result_yaml.h"
 #include "camera_imu_alignment/ros/message_input.h"
 #include "camera_imu_alignment/ros/wrapper_settings.h"
-#include "camera_imu_alignment/rotation_math.h"
-#include "camera_imu_alignment/target_description.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
+#include "camera_imu_alignment/vision/target_description.h"
 #include "cli_args.h"
 
 namespace cia = camera_imu_alignment;

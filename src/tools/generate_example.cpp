@@ -5,9 +5,9 @@
 #include <iomanip>
 #include <iostream>
 
-#include "camera_imu_alignment/csv_io.h"
-#include "camera_imu_alignment/example_data.h"
-#include "camera_imu_alignment/pose_window.h"
+#include "camera_imu_alignment/io/csv_io.h"
+#include "camera_imu_alignment/solver/example_data.h"
+#include "camera_imu_alignment/solver/pose_window.h"
 #include "cli_args.h"
 
 namespace cia = camera_imu_alignment;

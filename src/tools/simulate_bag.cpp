@@ -19,7 +19,7 @@
 #include <limits>
 #include <sstream>
 
-#include "camera_imu_alignment/rotation_math.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/simulation/renderer.h"
 #include "camera_imu_alignment/simulation/simulation_run.h"
 #include "camera_imu_alignment/simulation/target.h"

@@ -5,11 +5,11 @@
 #include <iomanip>
 #include <iostream>
 
-#include "camera_imu_alignment/alignment_solver.h"
-#include "camera_imu_alignment/csv_io.h"
-#include "camera_imu_alignment/pose_window.h"
-#include "camera_imu_alignment/result_yaml.h"
-#include "camera_imu_alignment/rotation_math.h"
+#include "camera_imu_alignment/solver/alignment_solver.h"
+#include "camera_imu_alignment/io/csv_io.h"
+#include "camera_imu_alignment/solver/pose_window.h"
+#include "camera_imu_alignment/io/result_yaml.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 #include "cli_args.h"
 
 namespace cia = camera_imu_alignment;

@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "camera_imu_alignment/alignment_solver.h"
+#include "camera_imu_alignment/solver/alignment_solver.h"
 #include "camera_imu_alignment/ros/wrapper_settings.h"
 
 namespace camera_imu_alignment {

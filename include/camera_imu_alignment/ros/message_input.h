@@ -30,7 +30,7 @@
 #include <optional>
 #include <string>
 
-#include "camera_imu_alignment/calibration_pipeline.h"
+#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
 
 namespace camera_imu_alignment {
 

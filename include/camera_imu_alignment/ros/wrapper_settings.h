@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "camera_imu_alignment/calibration_pipeline.h"
+#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
 
 namespace camera_imu_alignment {
 

@@ -1,0 +1,45 @@
+// The calibration result YAML of shared/CONVENTIONS.md (R_cam_imu as quaternion_xyzw and matrix,
+// Kalibr-style T_cam_imu with zero translation, quality block), plus extra keys: method, two_step,
+// observability details, per-pair residuals, R_imu_cam.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+
+#include "camera_imu_alignment/solver/alignment_solver.h"
+
+namespace camera_imu_alignment {
+
+struct ResultMetadata {
+  std::string camera_frame = "camera_optical_frame";  ///< image header frame_id
+  std::string imu_frame = "imu_link";                 ///< Imu header frame_id
+  int num_poses = 0;  ///< stationary poses behind the pairs (0: pairs given)
+};
+
+/// The result document as YAML text.
+std::string resultToYaml(const AlignmentResult& result, const ResultMetadata& meta);
+
+/// Writes the YAML atomically (temporary file in the same folder + rename), so a reader never sees
+/// a half-written file and a failed write leaves any previous file intact. Throws InputError.
+void writeResultYaml(const std::string& path, const AlignmentResult& result,
+                     const ResultMetadata& meta);
+
+/// R_cam_imu and frames read back from a result (or truth) YAML.
+struct StoredCalibration {
+  std::string camera_frame;
+  std::string imu_frame;
+  Eigen::Matrix3d R_cam_imu = Eigen::Matrix3d::Identity();
+};
+
+/// Reads R_cam_imu (quaternion_xyzw, else matrix) from a result YAML. Throws InputError naming the
+/// file and the key on any problem (missing key, not finite, not a rotation).
+StoredCalibration readResultYaml(const std::string& path);
+
+/// For a node starting up: the calibration saved at `path`, nullopt when there is no file. A file
+/// that cannot be read (corrupt, truncated, not a rotation) is renamed to `path + ".bad"`, kept for
+/// inspection and never read again, and `warning` says so; the node then starts fresh.
+std::optional<StoredCalibration> loadSavedCalibration(const std::string& path,
+                                                      std::string* warning);
+
+}  // namespace camera_imu_alignment

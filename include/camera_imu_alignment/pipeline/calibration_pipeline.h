@@ -1,0 +1,200 @@
+// The offline and online calibration pipeline: time-stamped IMU, magnetometer and camera
+// observations in, stationary poses, relative-rotation pairs and R_cam_imu out. calibrate_bag and
+// the nodelet both drive this class; it holds no ROS type.
+//
+// Data path:
+//   IMU samples -> validation -> StationaryDetector -> segments (gyro bias, mean accel)
+//   magnetometer samples -> validation, unit check, calibration -> per-segment mean field
+//   camera frames -> queued until the IMU shows whether the frame time is at rest; detection + PnP
+//     only on frames at rest (never while moving), at most max_frames_per_pose per pose
+//   segment end -> StationaryPose (camera: robust average of the frame orientations; IMU: see
+//     below) -> PoseWindow -> solveAlignment -> callbacks.
+//
+// IMU orientation of a pose (rule, PipelineSettings::imu_orientation):
+//   kAuto (default): the gyro, integrated bias-corrected from the previous pose (bias: mean of the
+//     two segments' gyro means), chained onto the previous pose's R_world_imu. The chain is
+//     anchored by accelerometer + magnetometer at its first pose (accelerometer alone, heading 0,
+//     without a usable magnetometer). When the chain breaks (IMU gap, buffer limit) it restarts at
+//     the next pose; without a magnetometer the new chain's heading is unrelated to the old one, so
+//     the poses get a new group and pairs are formed only within a group. When the magnetometer is
+//     usable at both poses, the gyro and the accelerometer+magnetometer relative rotations are
+//     compared and the difference is reported (gyro_mag_difference_deg).
+//   kMagnetometer (the paper's): accelerometer + magnetometer at every pose where the field is
+//     usable, the gyro chain otherwise.
+//   kMessage: the IMU's own orientation estimate (sensor_msgs/Imu orientation, e.g. an AHRS with
+//     an onboard filter), averaged over the rest, at every pose where at least 5 samples carry one;
+//     the gyro chain otherwise. Its world frame is the sensor's: one group.
+// Why the gyro first: over the few seconds between poses a bias-corrected MEMS gyro is accurate to
+// a few hundredths of a degree, while an accelerometer + magnetometer attitude carries the
+// accelerometer bias (tilt) and any uncalibrated iron or disturbance (heading) at every pose.
+//
+// Time offsets between camera and IMU stamps: a frame is used only when its stamp lies inside a
+// stationary segment shrunk by frame_margin_s at both ends (the segment itself is already trimmed
+// by half a detector window); within a rest the orientation is constant, so any offset smaller
+// than the margin changes nothing.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "camera_imu_alignment/solver/alignment_solver.h"
+#include "camera_imu_alignment/vision/camera_model.h"
+#include "camera_imu_alignment/inertial/imu_attitude.h"
+#include "camera_imu_alignment/inertial/inertial_samples.h"
+#include "camera_imu_alignment/inertial/magnetometer.h"
+#include "camera_imu_alignment/solver/pose_window.h"
+#include "camera_imu_alignment/inertial/stationary_detector.h"
+#include "camera_imu_alignment/vision/target_detector.h"
+
+namespace camera_imu_alignment {
+
+/// One camera frame: an image converted to mono8 by the caller (ROS wrapper / bag reader), or a
+/// camera orientation given from elsewhere.
+struct CameraFrame {
+  double stamp_s = 0.0;
+  cv::Mat mono8;  ///< CV_8UC1; unused when R_target_cam is given
+  /// The camera orientation when it comes from elsewhere (the user's own detector, motion capture:
+  /// the nodelet's camera_pose topic): then no image and no detection are needed. Use either
+  /// images or given orientations in one pipeline, not both (they share the stamp order).
+  std::optional<Eigen::Matrix3d> R_target_cam;
+};
+
+enum class ImuOrientationSource { kAuto, kMagnetometer, kMessage };
+const char* toString(ImuOrientationSource source);
+bool parseImuOrientationSource(const std::string& text, ImuOrientationSource* source);
+
+struct PipelineSettings {
+  StationaryDetectorSettings stationary;
+  DisturbanceSettings disturbance;
+  MagnetometerCalibration magnetometer;
+  DetectorSettings detector;
+  PoseSettings pose;
+  SolverOptions solver;
+  ImuOrientationSource imu_orientation = ImuOrientationSource::kAuto;
+  std::size_t window_poses = 30;       ///< sliding window of stationary poses
+  int min_poses_to_solve = 3;          ///< solve only with at least this many poses in the window
+  int min_frames_per_pose = 2;         ///< camera frames with a pose needed for a stationary pose
+  int max_frames_per_pose = 10;        ///< detection stops after this many good frames per rest
+  double min_frame_interval_s = 0.15;  ///< frames closer than this to the last detected one skipped
+  /// After kMissesBeforeBackoff failed detections in a row at one rest (target out of view, a
+  /// miss costs up to 15x a hit), frames closer than this to the last attempt are skipped.
+  double missed_frame_interval_s = 1.0;
+  static constexpr int kMissesBeforeBackoff = 3;
+  double frame_margin_s = 0.15;        ///< see "Time offsets" above
+  double max_camera_spread_deg = 0.5;  ///< camera orientation scatter within a pose
+  double max_gyro_span_s = 120.0;      ///< longer motion between poses breaks the gyro chain
+  double frame_queue_s = 3.0;          ///< frames older than the IMU by more are dropped (no IMU)
+  double accel_weight = 0.9;           ///< attitudeFromAccelMag
+  /// Returns an empty string when usable, else the first unusable setting, named by its key in
+  /// config/default.yaml.
+  std::string validate() const;
+};
+
+/// A stationary pose as the pipeline assembled it.
+struct StationaryPose {
+  int index = 0;  ///< 0-based, in order of the recording
+  int group = 0;  ///< poses of different groups never form a pair (see the rule above)
+  double start_s = 0.0, end_s = 0.0;  ///< the IMU segment (s)
+  // Camera.
+  Eigen::Matrix3d R_target_cam = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d p_target_cam = Eigen::Vector3d::Zero();  ///< m, from the last frame used
+  int num_frames = 0;
+  double camera_spread_deg = 0.0;    ///< RMS of frame orientations about the average
+  double reprojection_rms_px = 0.0;  ///< mean over the frames used
+  // IMU.
+  Eigen::Matrix3d R_world_imu = Eigen::Matrix3d::Identity();  ///< used for the pairs
+  std::string imu_source;                                     ///< "gyro", "accel_mag", "accel_only"
+  bool magnetometer_usable = false;
+  std::string magnetometer_note;  ///< why not usable ("disturbed: dip changed by 5.1 deg", ...)
+  std::optional<Eigen::Matrix3d> R_world_imu_accel_mag;  ///< when the field is usable
+  std::optional<Eigen::Matrix3d>
+      R_imu_previous_imu_gyro;                    ///< gyro rotation since the previous pose
+  std::optional<double> gyro_mag_difference_deg;  ///< gyro vs accel+mag relative rotation
+  Eigen::Vector3d gyro_bias_rad_s = Eigen::Vector3d::Zero();
+};
+
+/// A rest period that did not become a pose, and why.
+struct RejectedPose {
+  double start_s = 0.0, end_s = 0.0;
+  std::string reason;  ///< "target seen in 1 frame (2 needed)", "camera spread 0.8 deg", ...
+};
+
+struct PipelineCallbacks {
+  std::function<void(const StationaryPose&)> on_pose;
+  std::function<void(const RejectedPose&)> on_pose_rejected;
+  std::function<void(const AlignmentResult&)> on_result;
+  /// Every rejected input: reason, the stream it came from, and a detail without the stream's
+  /// name ("stamp 12.5 s is earlier than ..."); the caller names the topic and throttles.
+  std::function<void(RejectReason, InputStream, const std::string&)> on_reject;
+};
+
+/// Sizes of everything the pipeline keeps, for diagnostics and the bounded-memory tests. Every
+/// one is capped: the buffers by time (max_gyro_span_s, frame_queue_s), the window by
+/// window_poses, the histories by CalibrationPipeline::kHistoryLimit.
+struct PipelineBufferSizes {
+  std::size_t imu = 0, mag = 0, frame_queue = 0, detections = 0;
+  std::size_t poses = 0, rests = 0, rejected_rests = 0, window = 0;
+};
+
+class CalibrationPipeline {
+ public:
+  /// poses(), segments() and rejectedPoses() keep the newest this many entries (a node running
+  /// for days must not grow); the totals count all.
+  static constexpr std::size_t kHistoryLimit = 1000;
+
+  /// Throws std::invalid_argument when settings.validate() fails.
+  CalibrationPipeline(const TargetDescription& target, const PipelineSettings& settings,
+                      PipelineCallbacks callbacks = {});
+  ~CalibrationPipeline();
+
+  void addImu(const ImuSample& sample);
+  void addMagnetic(const MagneticSample& sample);
+  /// Sets or replaces the intrinsics (validated; a bad one is counted and ignored).
+  bool setCameraIntrinsics(const CameraIntrinsics& intrinsics);
+  void addFrame(const CameraFrame& frame);
+  /// Counts an input refused before it reached the pipeline (a ROS message without a stamp, an
+  /// image that cannot be converted, ...) and reports it through on_reject like its own.
+  void rejectInput(RejectReason reason, InputStream stream, const std::string& detail);
+  /// End of data: closes the rest in progress and processes the queued frames.
+  void finish();
+  /// Solves on the current window (also done automatically after every new pose).
+  AlignmentResult solve() const;
+  /// Forgets all data (poses, window, buffers; counts kept unless clear_counts); the camera
+  /// intrinsics stay. Not from a callback.
+  void reset(bool clear_counts = false);
+  /// Keeps only the newest `count` poses in the solver's window (a remount); callbacks may call it.
+  void keepNewestPoses(std::size_t count);
+  std::size_t windowSize() const;  ///< poses in the solver's window
+
+  const std::vector<StationaryPose>& poses() const;  ///< the newest kHistoryLimit poses
+  RotationPairs windowPairs() const;  ///< the pairs solve() uses (poses in the window)
+  const std::vector<RejectedPose>& rejectedPoses() const;
+  const std::vector<StationarySegment>& segments() const;  ///< the newest kHistoryLimit rests
+  std::size_t posesTotal() const;  ///< poses since the start or the last reset
+  /// Gaps in the IMU stamps longer than max_imu_gap_s (each ends a rest in progress).
+  std::uint64_t imuGaps() const;
+  std::size_t restsTotal() const;  ///< IMU rests (segments) since the start or the last reset
+  PipelineBufferSizes bufferSizes() const;
+  const RejectionCounts& rejections() const;
+  std::optional<AlignmentResult> lastResult() const;
+  /// Counters for progress and diagnostics.
+  std::uint64_t imuSamples() const;
+  std::uint64_t magneticSamples() const;
+  std::uint64_t frames() const;
+  std::uint64_t framesDetected() const;  ///< frames on which detection ran
+  bool hasIntrinsics() const;
+  const PipelineSettings& settings() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace camera_imu_alignment

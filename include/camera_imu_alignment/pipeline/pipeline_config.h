@@ -1,0 +1,27 @@
+// PipelineSettings from a flat YAML map whose keys are the node's private parameter names
+// (config/default.yaml documents every key with its default and unit). calibrate_bag --config
+// and the nodelet read the same keys, so one file configures both.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+
+namespace camera_imu_alignment {
+
+/// Every key this reader knows, in documentation order.
+const std::vector<std::string>& pipelineConfigKeys();
+
+/// Reads a YAML file of `key: value` pairs over `settings` (absent keys keep their value).
+/// Throws InputError naming the file and key on an unknown key, a wrong type, a value out of
+/// range or an unusable combination (PipelineSettings::validate). Keys not read by the pipeline
+/// but used by the ROS wrapper (topics, frames, paths) are listed in `ignored_keys` and skipped.
+void loadPipelineConfig(const std::string& path, PipelineSettings* settings,
+                        const std::vector<std::string>& ignored_keys = {});
+/// Same from YAML text; `source` names it in messages.
+void parsePipelineConfig(const std::string& text, const std::string& source,
+                         PipelineSettings* settings,
+                         const std::vector<std::string>& ignored_keys = {});
+
+}  // namespace camera_imu_alignment

@@ -1,0 +1,88 @@
+// Finds a calibration target in a grey image and estimates the camera pose from it (PnP).
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "camera_imu_alignment/vision/camera_model.h"
+#include "camera_imu_alignment/vision/target_description.h"
+
+namespace camera_imu_alignment {
+
+/// Detected feature points: image_points[i] (pixels, distorted, OpenCV convention: pixel (0, 0)
+/// centred on (0, 0)) is target point point_ids[i] (TargetDescription::point index).
+struct TargetObservation {
+  std::vector<cv::Point2f> image_points;
+  std::vector<int> point_ids;
+};
+
+struct DetectorSettings {
+  int min_points = 16;   ///< fewer points found: not detected (aprilgrid: >= 4 tags)
+  bool subpixel = true;  ///< checkerboard corner refinement
+};
+
+/// Detects one target type in mono8 images. Checkerboard: cv::findChessboardCorners with a fast
+/// rejection (fallback findChessboardCornersSB for blurred or oblique views) + cornerSubPix,
+/// corners re-ordered so that index 0 is always the target origin (the 180-degree ambiguity is
+/// resolved by the square colours where the board allows it, otherwise by the orientation closest
+/// to `hint`); AprilGrid: tag36h11 via OpenCV aruco, Kalibr's layout, partial views allowed; circle
+/// grid: cv::findCirclesGrid (symmetric/asymmetric).
+class TargetDetector {
+ public:
+  explicit TargetDetector(const TargetDescription& target, const DetectorSettings& settings = {});
+  ~TargetDetector();
+  /// Detects the target in `mono8` (CV_8UC1). Returns false when not found. `R_target_cam_hint`
+  /// (optional) is a recent camera orientation used to resolve symmetric boards.
+  bool detect(const cv::Mat& mono8, TargetObservation* observation,
+              const Eigen::Matrix3d* R_target_cam_hint = nullptr) const;
+  const TargetDescription& target() const { return target_; }
+  /// Rotations S of the target frame (about its z axis, through the board centre; identity
+  /// excluded) under which this detector cannot tell the board from itself: the camera
+  /// orientation of a detection may be S * R_target_cam_true. A checkerboard with an even number
+  /// of inner corners along both axes looks the same turned by 180 degrees; a square grid also
+  /// turned by 90. AprilGrids have none (every tag has an id). The hint resolves these only while
+  /// the camera turns less than 90 degrees between hints; CalibrationPipeline checks each pose
+  /// against the IMU's rotation angle.
+  std::vector<Eigen::Matrix3d> symmetries() const;
+
+ private:
+  bool detectAprilGrid(const cv::Mat& mono8, TargetObservation* observation) const;
+
+  struct Impl;
+  TargetDescription target_;
+  DetectorSettings settings_;
+  std::unique_ptr<Impl> impl_;
+};
+
+struct PoseSettings {
+  double max_reprojection_rms_px = 1.0;  ///< poses above are rejected
+  /// Planar PnP has two solutions (IPPE); the pose is rejected as ambiguous when the second one's
+  /// reprojection RMS is within this factor of the first (they explain the image equally well).
+  double min_ambiguity_ratio = 1.5;
+};
+
+/// Camera pose relative to the target (CONVENTIONS: R_target_cam; p_target = R_target_cam p_cam +
+/// p_target_cam).
+struct CameraPose {
+  Eigen::Matrix3d R_target_cam = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d p_target_cam =
+      Eigen::Vector3d::Zero();  ///< camera centre in the target frame (m)
+  double reprojection_rms_px = 0.0;
+  double reprojection_mean_px = 0.0;  ///< mean reprojection distance (px)
+  double ambiguity_ratio = 0.0;  ///< second-best / best reprojection RMS of the planar solutions
+  int num_points = 0;
+};
+
+/// PnP (IPPE on undistorted points, then Levenberg-Marquardt refinement). Returns nullopt with the
+/// reason in `why` when there are too few points, PnP fails, the reprojection RMS is above the
+/// limit or the solution is ambiguous.
+std::optional<CameraPose> estimateCameraPose(const TargetObservation& observation,
+                                             const TargetDescription& target,
+                                             const CameraIntrinsics& intrinsics,
+                                             const PoseSettings& settings, std::string* why);
+
+}  // namespace camera_imu_alignment

@@ -1,0 +1,70 @@
+// Rejection reasons and their counts.
+#include "camera_imu_alignment/inertial/inertial_samples.h"
+
+#include <sstream>
+
+namespace camera_imu_alignment {
+
+const char* rejectReasonName(RejectReason reason) {
+  switch (reason) {
+    case RejectReason::kNonFinite:
+      return "non_finite";
+    case RejectReason::kZeroVector:
+      return "zero_vector";
+    case RejectReason::kStampBackwards:
+      return "stamp_backwards";
+    case RejectReason::kDuplicateStamp:
+      return "duplicate_stamp";
+    case RejectReason::kMissingStamp:
+      return "missing_stamp";
+    case RejectReason::kMagneticUnits:
+      return "magnetic_units";
+    case RejectReason::kBadImage:
+      return "bad_image";
+    case RejectReason::kBadCameraInfo:
+      return "bad_camera_info";
+    case RejectReason::kTargetNotFound:
+      return "target_not_found";
+    case RejectReason::kPoseRejected:
+      return "pose_rejected";
+    case RejectReason::kCount:
+      break;
+  }
+  return "unknown";
+}
+
+const char* inputStreamName(InputStream stream) {
+  switch (stream) {
+    case InputStream::kImu:
+      return "imu";
+    case InputStream::kMagnetometer:
+      return "mag";
+    case InputStream::kImage:
+      return "image";
+    case InputStream::kCameraInfo:
+      return "camera_info";
+    case InputStream::kCameraPose:
+      return "camera_pose";
+  }
+  return "unknown";
+}
+
+std::uint64_t RejectionCounts::total() const {
+  std::uint64_t sum = 0;
+  for (const std::uint64_t n : counts_) sum += n;
+  return sum;
+}
+
+std::string RejectionCounts::summary() const {
+  std::ostringstream out;
+  bool first = true;
+  for (std::size_t i = 0; i < counts_.size(); ++i) {
+    if (counts_[i] == 0) continue;
+    if (!first) out << ", ";
+    out << rejectReasonName(static_cast<RejectReason>(i)) << ": " << counts_[i];
+    first = false;
+  }
+  return first ? "none" : out.str();
+}
+
+}  // namespace camera_imu_alignment

@@ -1,0 +1,603 @@
+// The user-facing output of a calibration run: the stdout summary with blocks for Kalibr, OpenVINS,
+// VINS-Mono/Fusion and tf2, and the one-page PNG report (drawn with OpenCV primitives only).
+#include "camera_imu_alignment/io/calibration_report.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <vector>
+
+#include "camera_imu_alignment/solver/rotation_math.h"
+
+namespace camera_imu_alignment {
+namespace {
+
+/// Significant digits of exported numbers: a rotation entry (|x| <= 1) round-trips to 5e-10.
+constexpr int kExportDigits = 9;
+
+// --- Text helpers
+
+/// `value` with `decimals` fixed decimals, or "n/a" when not finite.
+std::string fixed(double value, int decimals) {
+  if (!std::isfinite(value)) return "n/a";
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(decimals) << value;
+  return out.str();
+}
+
+/// `value` with kExportDigits significant digits (for files other tools read back), always as a
+/// floating-point literal ("1.0", not "1").
+std::string exact(double value) {
+  std::ostringstream out;
+  out << std::setprecision(kExportDigits) << value;
+  std::string text = out.str();
+  if (text.find_first_of(".eEni") == std::string::npos) text += ".0";
+  return text;
+}
+
+std::string fixedList(const Eigen::Vector3d& v, int decimals) {
+  return "[" + fixed(v(0), decimals) + ", " + fixed(v(1), decimals) + ", " + fixed(v(2), decimals) +
+         "]";
+}
+
+std::string statusName(SolveStatus status) {
+  switch (status) {
+    case SolveStatus::kOk:
+      return "ok";
+    case SolveStatus::kNotObservable:
+      return "not observable";
+    case SolveStatus::kPoorFit:
+      return "poor fit";
+    case SolveStatus::kBadInput:
+      return "bad input";
+  }
+  return "unknown";
+}
+
+/// q_cam_imu with w >= 0 (q and -q are the same rotation).
+Eigen::Quaterniond canonicalQuaternion(const Eigen::Matrix3d& R) {
+  Eigen::Quaterniond q(R);
+  q.normalize();
+  if (q.w() < 0.0) q.coeffs() = -q.coeffs();
+  return q;
+}
+
+/// The four rows of the 4x4 transform [R 0; 0 1] as YAML flow sequences, one per line. A template
+/// so that R may be a transpose expression (no temporary).
+template <typename Derived>
+std::string transformRows(const Eigen::MatrixBase<Derived>& R, const std::string& indent) {
+  std::string rows;
+  for (int i = 0; i < 3; ++i) {
+    rows += indent + "- [" + exact(R(i, 0)) + ", " + exact(R(i, 1)) + ", " + exact(R(i, 2)) +
+            ", 0.0]\n";
+  }
+  return rows + indent + "- [0.0, 0.0, 0.0, 1.0]\n";
+}
+
+std::string kalibrBlock(const Eigen::Matrix3d& R_cam_imu) {
+  return "# Kalibr camchain-imucam.yaml: T_cam_imu maps IMU-frame points into the camera frame\n"
+         "# (p_cam = T_cam_imu * p_imu); rotation only: translation not estimated (0 here).\n"
+         "cam0:\n"
+         "  T_cam_imu:\n" +
+         transformRows(R_cam_imu, "  ");
+}
+
+std::string openVinsBlock(const Eigen::Matrix3d& R_cam_imu) {
+  return "# OpenVINS kalibr_imucam_chain.yaml: T_imu_cam = T_cam_imu^-1, R_imu_cam = R_cam_imu^T\n"
+         "# (p_imu = T_imu_cam * p_cam); rotation only, keep your measured translation.\n"
+         "cam0:\n"
+         "  T_imu_cam:\n" +
+         transformRows(R_cam_imu.transpose(), "    ");
+}
+
+std::string vinsBlock(const Eigen::Matrix3d& R_cam_imu) {
+  std::string data;  // R_imu_cam row by row: R_imu_cam(i, k) = R_cam_imu(k, i)
+  for (int i = 0; i < 3; ++i) {
+    data += (i == 0 ? "   data: [" : ",\n          ");
+    data += exact(R_cam_imu(0, i)) + ", " + exact(R_cam_imu(1, i)) + ", " + exact(R_cam_imu(2, i));
+  }
+  return "# VINS-Mono / VINS-Fusion config: extrinsicRotation = R_imu_cam (camera to body/IMU,\n"
+         "# p_imu = R * p_cam, row-major); VINS-Fusion's body_T_cam0 has the same rotation.\n"
+         "extrinsicRotation: !!opencv-matrix\n"
+         "   rows: 3\n"
+         "   cols: 3\n"
+         "   dt: d\n" +
+         data + "]\n";
+}
+
+std::string tfBlock(const Eigen::Matrix3d& R_cam_imu, const std::string& camera_frame,
+                    const std::string& imu_frame) {
+  const Eigen::Quaterniond q = canonicalQuaternion(R_cam_imu);
+  return "# tf2: parent = camera frame, child = IMU frame (maps IMU-frame points into the camera "
+         "frame):\n"
+         "rosrun tf2_ros static_transform_publisher 0 0 0 " +
+         exact(q.x()) + " " + exact(q.y()) + " " + exact(q.z()) + " " + exact(q.w()) + " " +
+         (camera_frame.empty() ? "camera_optical_frame" : camera_frame) + " " +
+         (imu_frame.empty() ? "imu_link" : imu_frame) + "\n";
+}
+
+// --- Summary sections
+
+void writeEstimate(std::ostream& out, const ReportInput& in) {
+  const Eigen::Matrix3d& R = in.result.R_cam_imu;
+  const Eigen::Quaterniond q = canonicalQuaternion(R);
+  out << "R_cam_imu (p_cam = R_cam_imu * p_imu; camera '" << in.camera_frame << "', IMU '"
+      << in.imu_frame << "'):\n";
+  out << "  quaternion xyzw: [" << fixed(q.x(), 9) << ", " << fixed(q.y(), 9) << ", "
+      << fixed(q.z(), 9) << ", " << fixed(q.w(), 9) << "]\n";
+  out << "  matrix:\n";
+  for (int i = 0; i < 3; ++i) out << "    " << fixedList(R.row(i).transpose(), 9) << "\n";
+  out << "  roll, pitch, yaw (deg, R = Rz(yaw) Ry(pitch) Rx(roll)): "
+      << fixedList(rollPitchYawDeg(R), 4) << "\n";
+}
+
+/// True when the result is not observable and names a weak axis (not for bad input).
+bool hasAxisAdvice(const AlignmentResult& r) {
+  const SolutionQuality& q = r.quality;
+  return !q.observable && r.status != SolveStatus::kBadInput && q.weak_axis_cam.allFinite() &&
+         q.excite_axis_cam.allFinite() && q.weak_axis_cam.norm() > 0.0;
+}
+
+void writeQuality(std::ostream& out, const ReportInput& in) {
+  const SolutionQuality& q = in.result.quality;
+  out << "1-sigma about camera x, y, z (deg): " << fixedList(q.std_dev_deg, 4) << "\n";
+  out << "residual RMS (deg): " << fixed(q.residual_rms_deg, 4) << " over " << q.num_inliers
+      << " inlier(s) of " << q.num_pairs << " pair(s)\n";
+  out << "observable: " << (q.observable ? "yes" : "NO") << " (observability "
+      << fixed(q.observability, 3) << ", 0 = one rotation axis .. 1 = all axes evenly)\n";
+  if (hasAxisAdvice(in.result)) {
+    out << "  rotate the rig about the camera " << axisName(q.excite_axis_cam)
+        << " axis to constrain the rotation about camera " << axisName(q.weak_axis_cam) << "\n";
+  }
+  if (!q.observable && !q.observability_message.empty()) {
+    out << "  (" << q.observability_message << ")\n";
+  }
+  out << "solver: " << toString(in.result.method) << ", " << in.result.iterations
+      << " iteration(s), " << (in.result.converged ? "converged" : "not converged") << "\n";
+}
+
+void writePoses(std::ostream& out, const ReportInput& in) {
+  out << "poses used: " << in.poses.size() << ", rests rejected: " << in.rejected.size()
+      << ", IMU rests: " << in.segments.size() << "\n";
+  for (const RejectedPose& r : in.rejected) {
+    out << "  rejected rest " << fixed(r.start_s - in.start_s, 2) << "-"
+        << fixed(r.end_s - in.start_s, 2)
+        << " s (from start): " << (r.reason.empty() ? "(no reason given)" : r.reason) << "\n";
+  }
+  out << "inputs rejected: " << in.rejections.summary() << "\n";
+}
+
+// --- Drawing helpers (BGR colours, pixel coordinates)
+
+const cv::Scalar kBlack(0, 0, 0), kGrey(150, 150, 150), kLightGrey(225, 225, 225);
+const cv::Scalar kBlue(200, 110, 30), kGreen(40, 160, 40), kRed(30, 30, 220), kOrange(0, 140, 255);
+constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
+
+int textWidth(const std::string& text, double scale) {
+  int baseline = 0;
+  return cv::getTextSize(text, kFont, scale, 1, &baseline).width;
+}
+
+/// `text` shortened with "..." so that it fits in `max_width` px.
+std::string fitText(std::string text, int max_width, double scale) {
+  if (textWidth(text, scale) <= max_width) return text;
+  while (!text.empty() && textWidth(text + "...", scale) > max_width) text.pop_back();
+  return text + "...";
+}
+
+/// `text` broken at spaces into at most `max_lines` lines of at most `max_width` px (the last one
+/// shortened with "...").
+std::vector<std::string> wrapText(const std::string& text, int max_width, double scale,
+                                  int max_lines) {
+  std::vector<std::string> lines;
+  std::istringstream words(text);
+  std::string word, current;
+  while (words >> word) {
+    const std::string candidate = current.empty() ? word : current + " " + word;
+    if (current.empty() || textWidth(candidate, scale) <= max_width) {
+      current = candidate;
+      continue;
+    }
+    lines.push_back(current);
+    current = word;
+  }
+  if (!current.empty()) lines.push_back(current);
+  if (static_cast<int>(lines.size()) > max_lines) {
+    lines.resize(max_lines);
+    lines.back() += " ...";
+  }
+  for (std::string& line : lines) line = fitText(line, max_width, scale);
+  return lines;
+}
+
+void putText(cv::Mat& img, const std::string& text, cv::Point origin, double scale,
+             const cv::Scalar& colour, int max_width = 10000) {
+  cv::putText(img, fitText(text, max_width, scale), origin, kFont, scale, colour, 1, cv::LINE_AA);
+}
+
+void panelFrame(cv::Mat& img, const cv::Rect& panel, const std::string& title) {
+  cv::rectangle(img, panel, kGrey, 1);
+  putText(img, title, panel.tl() + cv::Point(8, 20), 0.55, kBlack, panel.width - 16);
+}
+
+/// Smallest 1, 2 or 5 times a power of ten >= value (value > 0).
+double niceCeil(double value) {
+  const double p = std::pow(10.0, std::floor(std::log10(value)));
+  for (double m : {1.0, 2.0, 5.0, 10.0}) {
+    if (m * p >= value * (1.0 - 1e-12)) return m * p;
+  }
+  return 10.0 * p;
+}
+
+// --- (a) Residual bars
+
+/// Top of the residual axis (deg): a round number above the largest inlier residual (all pairs
+/// when none is an inlier), so that one gross outlier does not flatten the inlier bars.
+double residualAxisTopDeg(const SolutionQuality& q) {
+  double max_inlier = 0.0, max_all = 0.0;
+  for (const PairDiagnostics& p : q.pairs) {
+    if (!std::isfinite(p.residual_deg)) continue;
+    max_all = std::max(max_all, std::abs(p.residual_deg));
+    if (p.inlier) max_inlier = std::max(max_inlier, std::abs(p.residual_deg));
+  }
+  const double top = max_inlier > 0.0 ? max_inlier : max_all;
+  return niceCeil(std::max(top, 0.01));  // noise-free data: bars at 0 on a 0.01 deg axis
+}
+
+void drawResidualScale(cv::Mat& img, const cv::Rect& panel, const cv::Rect& plot, double top_deg) {
+  for (int i = 0; i <= 4; ++i) {  // y-axis scale, 0 .. top_deg
+    const int y = plot.y + plot.height - i * plot.height / 4;
+    cv::line(img, {plot.x, y}, {plot.x + plot.width, y}, kLightGrey, 1);
+    std::ostringstream label;
+    label << std::setprecision(3) << top_deg * i / 4.0;
+    putText(img, label.str(), {panel.x + 6, y + 4}, 0.4, kBlack);
+  }
+  putText(img, "deg", {panel.x + 6, plot.y - 16}, 0.4, kBlack);
+}
+
+/// One bar per pair; residuals above the axis are clipped and marked with their value.
+void drawResiduals(cv::Mat& img, const cv::Rect& panel, const SolutionQuality& q) {
+  panelFrame(img, panel, "(a) residual per pair (deg): inliers blue, outliers red");
+  const cv::Rect plot(panel.x + 60, panel.y + 50, panel.width - 80, panel.height - 90);
+  if (q.pairs.empty()) {
+    putText(img, "no pairs", plot.tl() + cv::Point(10, plot.height / 2), 0.6, kGrey);
+    return;
+  }
+  const double top_deg = residualAxisTopDeg(q);
+  drawResidualScale(img, panel, plot, top_deg);
+  const double step = static_cast<double>(plot.width) / q.pairs.size();
+  const int bottom = plot.y + plot.height;
+  for (std::size_t j = 0; j < q.pairs.size(); ++j) {
+    const PairDiagnostics& p = q.pairs[j];
+    const int x0 = plot.x + static_cast<int>(j * step);
+    const int x1 = std::max(x0, plot.x + static_cast<int>((j + 1) * step) - (step > 3 ? 1 : 0));
+    if (!std::isfinite(p.residual_deg)) {
+      putText(img, "?", {x0, bottom - 4}, 0.4, kOrange);
+      continue;
+    }
+    const double frac = std::min(1.0, std::abs(p.residual_deg) / top_deg);
+    const int y = bottom - static_cast<int>(std::lround(frac * plot.height));
+    const cv::Scalar& colour = p.inlier ? kBlue : kRed;
+    cv::rectangle(img, cv::Point(x0, y), cv::Point(x1, bottom), colour, cv::FILLED);
+    if (std::abs(p.residual_deg) > top_deg) {  // clipped: print the value above the plot
+      putText(img, fixed(p.residual_deg, 1), {std::min(x0, plot.x + plot.width - 30), plot.y - 4},
+              0.35, colour);
+    }
+  }
+  cv::rectangle(img, plot, kBlack, 1);
+  putText(img,
+          "pair index 0.." + std::to_string(q.pairs.size() - 1) +
+              "   RMS over inliers: " + fixed(q.residual_rms_deg, 3) + " deg",
+          {plot.x, bottom + 22}, 0.45, kBlack, plot.width);
+}
+
+// --- (b) Rotation-axis coverage in the camera frame
+
+/// One orthographic view of the axis hemisphere whose pole is camera axis `pole` (0, 1, 2):
+/// horizontal = camera axis `u`, vertical = camera axis `v` (drawn upwards).
+struct HemisphereView {
+  cv::Point centre;
+  int radius;
+  int pole, u, v;
+  cv::Point project(const Eigen::Vector3d& axis_cam) const {
+    const Eigen::Vector3d a = axis_cam(pole) < 0.0 ? Eigen::Vector3d(-axis_cam) : axis_cam;
+    return centre + cv::Point(static_cast<int>(std::lround(radius * a(u))),
+                              -static_cast<int>(std::lround(radius * a(v))));
+  }
+};
+
+void drawViewFrame(cv::Mat& img, const HemisphereView& view) {
+  static const char* kNames[] = {"x", "y", "z"};
+  cv::circle(img, view.centre, view.radius, kGrey, 1, cv::LINE_AA);
+  cv::line(img, view.centre - cv::Point(view.radius, 0), view.centre + cv::Point(view.radius, 0),
+           kLightGrey, 1);
+  cv::line(img, view.centre - cv::Point(0, view.radius), view.centre + cv::Point(0, view.radius),
+           kLightGrey, 1);
+  putText(img, kNames[view.u], view.centre + cv::Point(view.radius + 4, 5), 0.5, kBlack);
+  putText(img, kNames[view.v], view.centre + cv::Point(-4, -view.radius - 6), 0.5, kBlack);
+  putText(img, std::string("looking along camera ") + kNames[view.pole],
+          view.centre + cv::Point(-view.radius, view.radius + 22), 0.45, kBlack);
+}
+
+/// RMS rotation angle (deg) about each camera axis over the pairs (axis components weighted).
+Eigen::Vector3d excitationPerAxisDeg(const RotationPairs& pairs) {
+  Eigen::Vector3d sum_sq = Eigen::Vector3d::Zero();
+  for (const RotationPair& p : pairs) {
+    const Eigen::Vector3d v = logSO3(p.A_cam);  // axis * angle (rad), camera frame
+    if (v.allFinite()) sum_sq += v.cwiseAbs2();
+  }
+  if (pairs.empty()) return Eigen::Vector3d::Zero();
+  return (sum_sq / static_cast<double>(pairs.size())).cwiseSqrt() * (180.0 / kPi);
+}
+
+void drawAxisCoverage(cv::Mat& img, const cv::Rect& panel, const ReportInput& in) {
+  panelFrame(img, panel, "(b) rotation axes of the camera pairs A_j (camera frame)");
+  const SolutionQuality& q = in.result.quality;
+  const int radius = std::min(panel.width / 4 - 30, panel.height / 2 - 80);
+  const int cy = panel.y + 50 + radius;
+  const HemisphereView views[] = {{{panel.x + panel.width / 4, cy}, radius, 2, 0, 1},
+                                  {{panel.x + 3 * panel.width / 4, cy}, radius, 0, 1, 2}};
+  for (const HemisphereView& view : views) drawViewFrame(img, view);
+  for (std::size_t j = 0; j < in.pairs.size(); ++j) {
+    const Eigen::Vector3d v = logSO3(in.pairs[j].A_cam);
+    if (!v.allFinite() || v.norm() < 1e-9) continue;  // no axis for a zero rotation
+    const bool outlier = j < q.pairs.size() && !q.pairs[j].inlier;
+    for (const HemisphereView& view : views) {
+      cv::circle(img, view.project(v.normalized()), 3, outlier ? kRed : kBlue, cv::FILLED,
+                 cv::LINE_AA);
+    }
+  }
+  if (hasAxisAdvice(in.result)) {
+    for (const HemisphereView& view : views) {
+      cv::drawMarker(img, view.project(q.weak_axis_cam.normalized()), kOrange, cv::MARKER_CROSS, 14,
+                     2);
+    }
+  }
+  const Eigen::Vector3d rms = excitationPerAxisDeg(in.pairs);
+  int y = cy + radius + 50;
+  putText(img,
+          "RMS rotation about camera x, y, z (deg): " + fixedList(rms, 1) + "   (" +
+              std::to_string(in.pairs.size()) + " pairs)",
+          {panel.x + 10, y}, 0.45, kBlack, panel.width - 20);
+  y += 20;
+  if (q.observable) {
+    putText(img, "all axes excited", {panel.x + 10, y}, 0.45, kGreen, panel.width - 20);
+  } else if (!hasAxisAdvice(in.result)) {
+    putText(img, "observability not evaluated", {panel.x + 10, y}, 0.45, kRed, panel.width - 20);
+  } else {
+    putText(img,
+            "axis " + axisName(q.weak_axis_cam) + " not excited (orange +): rotate about camera " +
+                axisName(q.excite_axis_cam),
+            {panel.x + 10, y}, 0.45, kRed, panel.width - 20);
+  }
+}
+
+// --- (c) Timeline of rests, poses and rejected rests
+
+/// Maps recording time (s) to a pixel column of `plot`, clamped to it.
+struct TimeAxis {
+  double t0 = 0.0, t1 = 1.0;
+  cv::Rect plot;
+  int x(double t) const {
+    if (!std::isfinite(t)) return plot.x;
+    const double f = std::clamp((t - t0) / (t1 - t0), 0.0, 1.0);
+    return plot.x + static_cast<int>(std::lround(f * plot.width));
+  }
+};
+
+/// The time span to show: [start_s, end_s], else the extent of what is drawn, else [0, 1].
+TimeAxis makeTimeAxis(const ReportInput& in, const cv::Rect& plot) {
+  TimeAxis axis;
+  axis.plot = plot;
+  auto usable = [](double a, double b) { return std::isfinite(b - a) && b > a; };
+  double lo = in.start_s, hi = in.end_s;
+  if (!usable(lo, hi)) {
+    lo = HUGE_VAL;
+    hi = -HUGE_VAL;
+    auto extend = [&](double a, double b) {
+      if (std::isfinite(a)) lo = std::min(lo, a);
+      if (std::isfinite(b)) hi = std::max(hi, b);
+    };
+    for (const auto& s : in.segments) extend(s.start_s, s.end_s);
+    for (const auto& p : in.poses) extend(p.start_s, p.end_s);
+    for (const auto& r : in.rejected) extend(r.start_s, r.end_s);
+    if (!usable(lo, hi)) {
+      lo = std::isfinite(in.start_s) ? in.start_s : (std::isfinite(lo) ? lo : 0.0);
+      hi = lo + 1.0;
+    }
+    if (!usable(lo, hi)) {  // lo so large that lo + 1 == lo
+      lo = 0.0;
+      hi = 1.0;
+    }
+  }
+  axis.t0 = lo;
+  axis.t1 = hi;
+  return axis;
+}
+
+void drawTimeTicks(cv::Mat& img, const TimeAxis& axis) {
+  const double span = axis.t1 - axis.t0;
+  const double step = niceCeil(span / 10.0);
+  const int y = axis.plot.y + axis.plot.height;
+  cv::line(img, {axis.plot.x, y}, {axis.plot.x + axis.plot.width, y}, kBlack, 1);
+  if (!(std::isfinite(step) && step > 0.0)) return;
+  for (int i = 0; i <= 20 && i * step <= span * (1.0 + 1e-9); ++i) {
+    const double dt = i * step;
+    const int x = axis.x(axis.t0 + dt);
+    cv::line(img, {x, y}, {x, y + 5}, kBlack, 1);
+    std::ostringstream label;
+    label << std::setprecision(4) << dt;
+    putText(img, label.str(), {x - 8, y + 20}, 0.4, kBlack);
+  }
+}
+
+void drawInterval(cv::Mat& img, const TimeAxis& axis, double a, double b, int y, int h,
+                  const cv::Scalar& colour, const std::string& label) {
+  const int x0 = axis.x(a), x1 = std::max(axis.x(b), x0 + 1);
+  cv::rectangle(img, cv::Point(x0, y), cv::Point(x1, y + h), colour, cv::FILLED);
+  if (!label.empty() && textWidth(label, 0.4) + 4 <= x1 - x0) {
+    putText(img, label, {x0 + 2, y + h - 5}, 0.4, cv::Scalar(255, 255, 255));
+  }
+}
+
+/// Short tag of rejected rest i in the timeline ("r1", ...), listed with its reason in panel (d).
+std::string rejectedTag(std::size_t i) { return "r" + std::to_string(i + 1); }
+
+void drawTimeline(cv::Mat& img, const cv::Rect& panel, const ReportInput& in) {
+  panelFrame(img, panel,
+             "(c) timeline (s from start): IMU rests grey, poses used green, rejected rests red");
+  const cv::Rect plot(panel.x + 110, panel.y + 32, panel.width - 130, panel.height - 64);
+  const TimeAxis axis = makeTimeAxis(in, plot);
+  const int row_h = (plot.height - 8) / 3;
+  const char* rows[] = {"IMU rests", "poses", "rejected"};
+  for (int r = 0; r < 3; ++r) {
+    putText(img, rows[r], {panel.x + 8, plot.y + r * row_h + row_h - 6}, 0.45, kBlack);
+  }
+  for (const StationarySegment& s : in.segments) {
+    drawInterval(img, axis, s.start_s, s.end_s, plot.y, row_h - 4, kGrey, "");
+  }
+  for (const StationaryPose& p : in.poses) {
+    drawInterval(img, axis, p.start_s, p.end_s, plot.y + row_h, row_h - 4, kGreen,
+                 std::to_string(p.index));
+  }
+  for (std::size_t i = 0; i < in.rejected.size(); ++i) {
+    const RejectedPose& r = in.rejected[i];
+    const int box_px = axis.x(r.end_s) - axis.x(r.start_s);
+    const std::string label = textWidth(r.reason, 0.4) + 4 <= box_px ? r.reason : rejectedTag(i);
+    drawInterval(img, axis, r.start_s, r.end_s, plot.y + 2 * row_h, row_h - 4, kRed, label);
+  }
+  if (in.segments.empty() && in.poses.empty() && in.rejected.empty()) {
+    putText(img, "no stationary segments", {plot.x + 10, plot.y + row_h - 6}, 0.45, kGrey);
+  }
+  drawTimeTicks(img, axis);
+}
+
+// --- (d) Estimate and quality as text
+
+cv::Scalar statusColour(SolveStatus status) {
+  if (status == SolveStatus::kOk) return kGreen;
+  return status == SolveStatus::kNotObservable ? kOrange : kRed;
+}
+
+void drawEstimateText(cv::Mat& img, const cv::Rect& panel, const ReportInput& in) {
+  panelFrame(img, panel, "(d) estimate");
+  const AlignmentResult& r = in.result;
+  const SolutionQuality& q = r.quality;
+  const Eigen::Quaterniond quat = canonicalQuaternion(r.R_cam_imu);
+  const int width = panel.width - 20;
+  int y = panel.y + 44;
+  auto line = [&](const std::string& text, const cv::Scalar& colour) {
+    putText(img, text, {panel.x + 10, y}, 0.5, colour, width);
+    y += 22;
+  };
+  line("status: " + statusName(r.status), statusColour(r.status));
+  for (const std::string& text : wrapText(r.message, width, 0.5, 2)) line(text, kBlack);
+  line("q_cam_imu (x, y, z, w): [" + fixed(quat.x(), 6) + ", " + fixed(quat.y(), 6) + ", " +
+           fixed(quat.z(), 6) + ", " + fixed(quat.w(), 6) + "]   (p_cam = R_cam_imu * p_imu, " +
+           in.camera_frame + " <- " + in.imu_frame + ")",
+       kBlack);
+  line("roll, pitch, yaw (deg, R = Rz Ry Rx): " + fixedList(rollPitchYawDeg(r.R_cam_imu), 3),
+       kBlack);
+  line("1-sigma about camera x, y, z (deg): " + fixedList(q.std_dev_deg, 4), kBlack);
+  line("residual RMS: " + fixed(q.residual_rms_deg, 4) + " deg   inliers: " +
+           std::to_string(q.num_inliers) + " / " + std::to_string(q.num_pairs) + " pairs",
+       kBlack);
+  const std::string advice =
+      hasAxisAdvice(r) ? " - rotate the rig about camera " + axisName(q.excite_axis_cam) : "";
+  line("observable: " + std::string(q.observable ? "yes" : "NO") + "  (observability " +
+           fixed(q.observability, 3) + ", weakest excitation " +
+           fixed(q.weakest_excitation_deg, 2) + " deg)" + advice,
+       q.observable ? kBlack : kRed);
+  line("poses used: " + std::to_string(in.poses.size()) + "   rests rejected: " +
+           std::to_string(in.rejected.size()) + "   inputs rejected: " + in.rejections.summary(),
+       kBlack);
+  std::string rests;
+  for (std::size_t i = 0; i < in.rejected.size(); ++i) {
+    const RejectedPose& rej = in.rejected[i];
+    rests += (i == 0 ? "rejected rests: " : "; ") + rejectedTag(i) + " " +
+             fixed(rej.start_s - in.start_s, 1) + "-" + fixed(rej.end_s - in.start_s, 1) +
+             " s: " + (rej.reason.empty() ? "(no reason given)" : rej.reason);
+  }
+  if (!rests.empty()) line(rests, kRed);
+}
+
+}  // namespace
+
+// --- Public functions
+
+Eigen::Vector3d rollPitchYawDeg(const Eigen::Matrix3d& R) {
+  // R = Rz(yaw) Ry(pitch) Rx(roll): R(2,0) = -sin(pitch), R(1,0)/R(0,0) = tan(yaw),
+  // R(2,1)/R(2,2) = tan(roll).
+  const double cos_pitch = std::hypot(R(0, 0), R(1, 0));
+  const double pitch = std::atan2(-R(2, 0), cos_pitch);
+  double roll = 0.0, yaw = 0.0;
+  if (cos_pitch > 1e-9) {
+    roll = std::atan2(R(2, 1), R(2, 2));
+    yaw = std::atan2(R(1, 0), R(0, 0));
+  } else {  // gimbal lock (pitch = +-90 deg): only yaw -+ roll is defined; report roll = 0
+    yaw = std::atan2(-R(0, 1), R(1, 1));
+  }
+  return Eigen::Vector3d(rad2deg(roll), rad2deg(pitch), rad2deg(yaw));
+}
+
+std::string exportBlocks(const Eigen::Matrix3d& R_cam_imu, const std::string& camera_frame,
+                         const std::string& imu_frame) {
+  return kalibrBlock(R_cam_imu) + "\n" + openVinsBlock(R_cam_imu) + "\n" + vinsBlock(R_cam_imu) +
+         "\n" + tfBlock(R_cam_imu, camera_frame, imu_frame);
+}
+
+std::string formatSummary(const ReportInput& input) {
+  std::ostringstream out;
+  out << "=== camera-IMU rotation"
+      << (input.source.empty() ? std::string() : " (" + input.source + ")") << " ===\n";
+  out << "status: " << statusName(input.result.status) << "\n";
+  if (!input.result.message.empty()) out << "message: " << input.result.message << "\n";
+  writeEstimate(out, input);
+  writeQuality(out, input);
+  writePoses(out, input);
+  out << "\n";
+  if (input.result.status != SolveStatus::kOk) {
+    out << "# WARNING: status '" << statusName(input.result.status)
+        << "': the blocks below hold the best guess only, do not use them as a calibration.\n";
+  }
+  out << exportBlocks(input.result.R_cam_imu, input.camera_frame, input.imu_frame);
+  return out.str();
+}
+
+cv::Mat renderReport(const ReportInput& input) {
+  constexpr int kWidth = 1200, kHeight = 900;
+  cv::Mat img(kHeight, kWidth, CV_8UC3, cv::Scalar(255, 255, 255));
+  const std::string title =
+      "camera-IMU rotation report" + (input.source.empty() ? std::string() : ": " + input.source);
+  putText(img, title, {10, 26}, 0.7, kBlack, kWidth - 20);
+  drawResiduals(img, cv::Rect(5, 40, 590, 400), input.result.quality);
+  drawAxisCoverage(img, cv::Rect(605, 40, 590, 400), input);
+  drawTimeline(img, cv::Rect(5, 448, 1190, 170), input);
+  drawEstimateText(img, cv::Rect(5, 626, 1190, 269), input);
+  return img;
+}
+
+bool writeReportPng(const std::string& path, const ReportInput& input, std::string* error) {
+  auto fail = [&](const std::string& why) {
+    if (error) *error = "cannot write report '" + path + "': " + why;
+    return false;
+  };
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  std::error_code ec;
+  if (!parent.empty() && !std::filesystem::is_directory(parent, ec)) {
+    return fail("directory '" + parent.string() + "' does not exist");
+  }
+  try {
+    if (!cv::imwrite(path, renderReport(input))) return fail("cv::imwrite failed");
+  } catch (const cv::Exception& e) {
+    return fail(e.what());
+  }
+  return true;
+}
+
+}  // namespace camera_imu_alignment

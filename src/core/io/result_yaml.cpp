@@ -1,0 +1,197 @@
+#include "camera_imu_alignment/io/result_yaml.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Geometry>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include "camera_imu_alignment/io/csv_io.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
+
+namespace camera_imu_alignment {
+namespace {
+
+std::string quoted(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string row(const Eigen::Vector3d& v) {
+  std::ostringstream out;
+  out << std::setprecision(9) << "[" << v(0) << ", " << v(1) << ", " << v(2) << "]";
+  return out.str();
+}
+
+std::string quaternionXyzw(const Eigen::Matrix3d& R) {
+  Eigen::Quaterniond q(R);
+  q.normalize();
+  if (q.w() < 0.0) q.coeffs() = -q.coeffs();  // canonical sign; q and -q are the same rotation
+  std::ostringstream out;
+  out << std::setprecision(12) << "[" << q.x() << ", " << q.y() << ", " << q.z() << ", " << q.w()
+      << "]";
+  return out.str();
+}
+
+void writeRotation(std::ostream& out, const std::string& name, const std::string& comment,
+                   const Eigen::Matrix3d& R) {
+  out << name << ":  # " << comment << "\n";
+  out << "  quaternion_xyzw: " << quaternionXyzw(R) << "\n";
+  out << "  matrix: [" << row(R.row(0)) << ", " << row(R.row(1)) << ", " << row(R.row(2)) << "]\n";
+}
+
+}  // namespace
+
+std::string resultToYaml(const AlignmentResult& r, const ResultMetadata& meta) {
+  const Eigen::Matrix3d& R = r.R_cam_imu;
+  const SolutionQuality& q = r.quality;
+  std::ostringstream out;
+  out << std::setprecision(6);
+  out << "camera_frame: " << quoted(meta.camera_frame) << "  # image header frame_id\n";
+  out << "imu_frame: " << quoted(meta.imu_frame) << "  # Imu header frame_id\n";
+  writeRotation(out, "R_cam_imu", "p_cam = R_cam_imu * p_imu", R);
+  out << "T_cam_imu:  # Kalibr camchain-imucam convention, translation zero\n";
+  for (int i = 0; i < 3; ++i) {
+    out << "  - [" << std::setprecision(9) << R(i, 0) << ", " << R(i, 1) << ", " << R(i, 2)
+        << ", 0.0]\n";
+  }
+  out << "  - [0.0, 0.0, 0.0, 1.0]\n" << std::setprecision(6);
+  writeRotation(out, "R_imu_cam", "p_imu = R_imu_cam * p_cam (OpenVINS / VINS-Mono direction)",
+                R.transpose());
+  out << "quality:\n";
+  out << "  observable: " << (q.observable ? "true" : "false") << "\n";
+  out << "  num_poses: " << meta.num_poses << "\n";
+  out << "  num_pairs: " << q.num_pairs << "\n";
+  out << "  num_inliers: " << q.num_inliers << "\n";
+  out << "  residual_rms_deg: " << q.residual_rms_deg << "\n";
+  out << "  std_dev_deg: " << row(q.std_dev_deg) << "  # 1-sigma about the camera x, y, z axes\n";
+  out << "  iterations: " << r.iterations << "\n";
+  out << "  converged: " << (r.converged ? "true" : "false") << "\n";
+  out << "  observability: " << q.observability << "  # 0 single axis .. 1 all axes evenly\n";
+  out << "  weakest_excitation_deg: " << q.weakest_excitation_deg << "\n";
+  out << "  weak_axis_cam: " << row(q.weak_axis_cam) << "  # least-constrained direction\n";
+  out << "  excite_axis_cam: " << row(q.excite_axis_cam) << "  # rotate about this to improve\n";
+  out << "  message: " << quoted(r.message) << "\n";
+  out << "  pair_residuals_deg: [";
+  for (size_t j = 0; j < q.pairs.size(); ++j) out << (j ? ", " : "") << q.pairs[j].residual_deg;
+  out << "]\n";
+  out << "  rejected_pairs:";
+  bool any_rejected = false;
+  for (size_t j = 0; j < q.pairs.size(); ++j) {
+    if (q.pairs[j].inlier) continue;
+    out << "\n    - {index: " << j << ", reason: " << quoted(q.pairs[j].rejection) << "}";
+    any_rejected = true;
+  }
+  out << (any_rejected ? "\n" : " []\n");
+  out << "solver:\n";
+  out << "  method: " << toString(r.method) << "\n";
+  out << "  start: " << r.start << "\n";
+  out << "  two_step:  # the paper's iteration, run at every solve\n";
+  out << "    converged: " << (r.two_step.converged ? "true" : "false") << "\n";
+  out << "    iterations: " << r.two_step.iterations << "\n";
+  out << "    R_cam_imu_left_quaternion_xyzw: " << quaternionXyzw(r.two_step.R_cam_imu_left)
+      << "\n";
+  out << "    R_cam_imu_right_quaternion_xyzw: " << quaternionXyzw(r.two_step.R_cam_imu_right)
+      << "\n";
+  out << "    difference_to_result_deg: " << rad2deg(geodesicDistance(r.two_step.R_cam_imu_left, R))
+      << "\n";
+  return out.str();
+}
+
+void writeResultYaml(const std::string& path, const AlignmentResult& result,
+                     const ResultMetadata& meta) {
+  // Written to a temporary file and renamed over the old one: a failed write (disk full, no
+  // permission) leaves the previous calibration as it was.
+  const std::string tmp = path + ".tmp";
+  const auto reason = [] { return std::string(" (") + std::strerror(errno) + ")"; };
+  {
+    errno = 0;
+    std::ofstream out(tmp);
+    if (!out) {
+      throw InputError(path + ": cannot write the temporary file " + tmp + reason() +
+                       "; the previous file is unchanged");
+    }
+    out << resultToYaml(result, meta);
+    out.flush();
+    if (!out) {
+      const std::string why = reason();
+      std::remove(tmp.c_str());
+      throw InputError(path + ": write error" + why + "; the previous file is unchanged");
+    }
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const std::string why = reason();
+    std::remove(tmp.c_str());
+    throw InputError(path + ": cannot replace the file" + why + "; the previous file is unchanged");
+  }
+}
+
+StoredCalibration readResultYaml(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw InputError(path + ": cannot open file");
+  } catch (const YAML::Exception& e) {
+    throw InputError(path + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML: " + e.msg);
+  }
+  StoredCalibration stored;
+  try {
+    if (root["camera_frame"]) stored.camera_frame = root["camera_frame"].as<std::string>();
+    if (root["imu_frame"]) stored.imu_frame = root["imu_frame"].as<std::string>();
+    const YAML::Node rot = root["R_cam_imu"];
+    if (!rot) throw InputError(path + ": no R_cam_imu key");
+    if (rot["quaternion_xyzw"]) {
+      const auto v = rot["quaternion_xyzw"].as<std::vector<double>>();
+      if (v.size() != 4) throw InputError(path + ": R_cam_imu.quaternion_xyzw needs 4 numbers");
+      Eigen::Quaterniond q(v[3], v[0], v[1], v[2]);
+      if (!q.coeffs().allFinite() || std::abs(q.norm() - 1.0) > kQuaternionNormTolerance) {
+        throw InputError(path + ": R_cam_imu.quaternion_xyzw is not a unit quaternion");
+      }
+      stored.R_cam_imu = q.normalized().toRotationMatrix();
+    } else if (rot["matrix"]) {
+      const auto m = rot["matrix"].as<std::vector<std::vector<double>>>();
+      if (m.size() != 3) throw InputError(path + ": R_cam_imu.matrix needs 3 rows");
+      for (int i = 0; i < 3; ++i) {
+        if (m[i].size() != 3) throw InputError(path + ": R_cam_imu.matrix needs 3 columns");
+        for (int k = 0; k < 3; ++k) stored.R_cam_imu(i, k) = m[i][k];
+      }
+      if (!isRotationMatrix(stored.R_cam_imu, 1e-4)) {
+        throw InputError(path + ": R_cam_imu.matrix is not a rotation matrix");
+      }
+      stored.R_cam_imu = projectToSO3(stored.R_cam_imu);
+    } else {
+      throw InputError(path + ": R_cam_imu has neither quaternion_xyzw nor matrix");
+    }
+  } catch (const YAML::Exception& e) {
+    throw InputError(path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+  return stored;
+}
+
+std::optional<StoredCalibration> loadSavedCalibration(const std::string& path,
+                                                      std::string* warning) {
+  warning->clear();
+  std::error_code ec;
+  if (path.empty() || !std::filesystem::exists(path, ec)) return std::nullopt;
+  try {
+    return readResultYaml(path);
+  } catch (const std::exception& e) {
+    const std::string aside = path + ".bad";
+    std::filesystem::rename(path, aside, ec);
+    *warning = std::string(e.what()) + (ec ? "; could not move it aside: " + ec.message()
+                                           : "; moved aside to " + aside + ", starting fresh");
+    return std::nullopt;
+  }
+}
+
+}  // namespace camera_imu_alignment

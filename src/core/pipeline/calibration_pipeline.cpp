@@ -1,0 +1,400 @@
+// CalibrationPipeline, input side: validation of samples and frames, the frame queue, detection
+// only at rest. Segment -> pose assembly is in pose_assembly.cpp.
+#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+#include "calibration_pipeline_impl.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
+
+namespace camera_imu_alignment {
+
+const char* toString(ImuOrientationSource source) {
+  switch (source) {
+    case ImuOrientationSource::kMagnetometer:
+      return "magnetometer";
+    case ImuOrientationSource::kMessage:
+      return "message";
+    default:
+      return "auto";
+  }
+}
+
+bool parseImuOrientationSource(const std::string& text, ImuOrientationSource* source) {
+  if (text == "auto") {
+    *source = ImuOrientationSource::kAuto;
+  } else if (text == "magnetometer") {
+    *source = ImuOrientationSource::kMagnetometer;
+  } else if (text == "message") {
+    *source = ImuOrientationSource::kMessage;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+namespace {
+
+std::string positive(const char* name, double value) {
+  if (std::isfinite(value) && value > 0.0) return "";
+  std::ostringstream out;
+  out << name << " = " << value << ": must be a finite number > 0";
+  return out.str();
+}
+
+bool finite(const Eigen::Vector3d& v) { return v.allFinite(); }
+
+}  // namespace
+
+std::string PipelineSettings::validate() const {
+  const std::pair<const char*, double> positives[] = {
+      {"stationary_window_s", stationary.window_s},
+      {"min_stationary_duration_s", stationary.min_duration_s},
+      {"max_gyro_norm_rad_s", stationary.max_gyro_rad_s},
+      {"max_initial_gyro_bias_rad_s", stationary.max_initial_gyro_bias_rad_s},
+      {"max_gyro_std_rad_s", stationary.max_gyro_std_rad_s},
+      {"max_accel_std_m_s2", stationary.max_accel_std_m_s2},
+      {"max_gravity_error_m_s2", stationary.max_gravity_error_m_s2},
+      {"gravity_m_s2", stationary.gravity_m_s2},
+      {"max_imu_gap_s", stationary.max_gap_s},
+      {"max_reprojection_rms_px", pose.max_reprojection_rms_px},
+      {"min_ambiguity_ratio", pose.min_ambiguity_ratio},
+      {"max_camera_spread_deg", max_camera_spread_deg},
+      {"max_gyro_span_s", max_gyro_span_s},
+      {"frame_queue_s", frame_queue_s},
+      {"mag_scale", magnetometer.scale},
+  };
+  for (const auto& [name, value] : positives) {
+    const std::string error = positive(name, value);
+    if (!error.empty()) return error;
+  }
+  const std::pair<const char*, double> more_positives[] = {
+      {"mag_max_norm_change", disturbance.max_norm_change},
+      {"mag_max_dip_change_deg", disturbance.max_dip_change_deg},
+      {"mag_max_scatter_deg", disturbance.max_within_segment_std_deg},
+  };
+  for (const auto& [name, value] : more_positives) {
+    const std::string error = positive(name, value);
+    if (!error.empty()) return error;
+  }
+  std::ostringstream out;
+  if (detector.min_points < 4) {
+    out << "min_target_points = " << detector.min_points << ": must be >= 4";
+  } else if (!(stationary.noise_factor >= 0.0 && std::isfinite(stationary.noise_factor))) {
+    out << "stationary_noise_factor = " << stationary.noise_factor << ": must be >= 0";
+  } else if (!(frame_margin_s >= 0.0 && std::isfinite(frame_margin_s))) {
+    out << "frame_margin_s = " << frame_margin_s << ": must be >= 0";
+  } else if (!(min_frame_interval_s >= 0.0 && std::isfinite(min_frame_interval_s))) {
+    out << "min_frame_interval_s = " << min_frame_interval_s << ": must be >= 0";
+  } else if (!(missed_frame_interval_s >= min_frame_interval_s &&
+               std::isfinite(missed_frame_interval_s))) {
+    out << "missed_frame_interval_s = " << missed_frame_interval_s
+        << ": must be finite and >= min_frame_interval_s";
+  } else if (window_poses < 2 || window_poses > 200) {
+    out << "window_poses = " << window_poses << ": must be within [2, 200]";
+  } else if (min_poses_to_solve < 2 ||
+             static_cast<std::size_t>(min_poses_to_solve) > window_poses) {
+    out << "min_poses_to_solve = " << min_poses_to_solve << ": must be within [2, window_poses]";
+  } else if (min_frames_per_pose < 1 || max_frames_per_pose < min_frames_per_pose) {
+    out << "min_frames_per_pose = " << min_frames_per_pose
+        << ", max_frames_per_pose = " << max_frames_per_pose << ": need 1 <= min <= max";
+  } else if (!(accel_weight > 0.0 && accel_weight < 1.0)) {
+    out << "accel_weight = " << accel_weight << ": must be within (0, 1)";
+  } else if (!magnetometer.hard_iron_t.allFinite() || !magnetometer.soft_iron.allFinite() ||
+             std::abs(magnetometer.soft_iron.determinant()) < 1e-6) {
+    out << "mag_hard_iron_t / mag_soft_iron: must be finite, mag_soft_iron invertible";
+  }
+  return out.str();
+}
+
+CalibrationPipeline::Impl::Impl(const TargetDescription& target_, const PipelineSettings& settings_,
+                                PipelineCallbacks callbacks_)
+    : target(target_),
+      settings(settings_),
+      callbacks(std::move(callbacks_)),
+      detector(target_, settings_.detector),
+      symmetries(detector.symmetries()),
+      stationary(settings_.stationary),
+      disturbance(settings_.disturbance),
+      window(settings_.window_poses) {}
+
+void CalibrationPipeline::Impl::reject(RejectReason reason, InputStream stream,
+                                       const std::string& detail) {
+  rejections.add(reason);
+  if (callbacks.on_reject) callbacks.on_reject(reason, stream, detail);
+}
+
+void CalibrationPipeline::rejectInput(RejectReason reason, InputStream stream,
+                                      const std::string& detail) {
+  impl_->reject(reason, stream, detail);
+}
+
+CalibrationPipeline::CalibrationPipeline(const TargetDescription& target,
+                                         const PipelineSettings& settings,
+                                         PipelineCallbacks callbacks) {
+  const std::string error = settings.validate();
+  if (!error.empty()) throw std::invalid_argument(error);
+  impl_ = std::make_unique<Impl>(target, settings, std::move(callbacks));
+}
+
+CalibrationPipeline::~CalibrationPipeline() = default;
+
+bool CalibrationPipeline::Impl::checkStamp(double stamp, double* last, InputStream stream) {
+  Impl* impl = this;
+  if (stamp < *last) {
+    std::ostringstream out;
+    out << std::setprecision(15) << "stamp " << stamp << " s is earlier than the previous one ("
+        << *last << " s); sample dropped";
+    impl->reject(RejectReason::kStampBackwards, stream, out.str());
+    return false;
+  }
+  if (stamp == *last) {
+    std::ostringstream out;
+    out << std::setprecision(15) << "duplicate stamp " << stamp << " s; sample dropped";
+    impl->reject(RejectReason::kDuplicateStamp, stream, out.str());
+    return false;
+  }
+  *last = stamp;
+  return true;
+}
+
+void CalibrationPipeline::addImu(const ImuSample& sample) {
+  Impl& s = *impl_;
+  if (!std::isfinite(sample.stamp_s) || !finite(sample.gyro_rad_s) || !finite(sample.accel_m_s2)) {
+    s.reject(RejectReason::kNonFinite, InputStream::kImu, "NaN or Inf in a sample; sample dropped");
+    return;
+  }
+  if (sample.accel_m_s2.norm() < 1e-6) {
+    s.reject(RejectReason::kZeroVector, InputStream::kImu,
+             "zero accelerometer vector; sample dropped");
+    return;
+  }
+  if (sample.q_world_imu && !(std::abs(sample.q_world_imu->norm() - 1.0) < 1e-3)) {
+    ImuSample without = sample;  // the rates are fine: keep them, drop the orientation
+    without.q_world_imu.reset();
+    s.reject(RejectReason::kNonFinite, InputStream::kImu,
+             "orientation is not a unit quaternion; orientation ignored, rates used");
+    addImu(without);
+    return;
+  }
+  const double previous_s = s.last_imu_stamp;
+  if (!s.checkStamp(sample.stamp_s, &s.last_imu_stamp, InputStream::kImu)) return;
+  ++s.num_imu;
+  if (std::isfinite(previous_s) && sample.stamp_s - previous_s > s.settings.stationary.max_gap_s) {
+    ++s.imu_gaps;
+  }
+  // Frames are judged with the rest state before this sample: a rest that ends with this sample
+  // still counts for frames taken inside it.
+  s.processFrames(false);
+  s.imu_buffer.push_back(sample);
+  while (!s.imu_buffer.empty() &&
+         s.imu_buffer.front().stamp_s < sample.stamp_s - s.settings.max_gyro_span_s) {
+    s.imu_buffer.pop_front();
+    s.imu_buffer_truncated = true;
+  }
+  if (auto segment = s.stationary.add(sample)) s.onSegment(*segment);
+}
+
+void CalibrationPipeline::addMagnetic(const MagneticSample& sample) {
+  Impl& s = *impl_;
+  if (!std::isfinite(sample.stamp_s) || !finite(sample.field_t)) {
+    s.reject(RejectReason::kNonFinite, InputStream::kMagnetometer,
+             "NaN or Inf in a sample; sample dropped");
+    return;
+  }
+  if (sample.field_t.norm() == 0.0) {
+    s.reject(RejectReason::kZeroVector, InputStream::kMagnetometer,
+             "zero field vector; sample dropped");
+    return;
+  }
+  if (!s.checkStamp(sample.stamp_s, &s.last_mag_stamp, InputStream::kMagnetometer)) return;
+  MagneticSample corrected = sample;
+  corrected.field_t = s.settings.magnetometer.apply(sample.field_t);
+  const double norm = corrected.field_t.norm();
+  const FieldUnits units = classifyFieldUnits(norm);
+  if (units != FieldUnits::kTesla) {
+    s.reject(RejectReason::kMagneticUnits, InputStream::kMagnetometer,
+             describeFieldUnits(units, norm));
+    return;
+  }
+  ++s.num_mag;
+  s.mag_buffer.push_back(corrected);
+  while (!s.mag_buffer.empty() &&
+         s.mag_buffer.front().stamp_s < sample.stamp_s - s.settings.max_gyro_span_s) {
+    s.mag_buffer.pop_front();
+  }
+}
+
+bool CalibrationPipeline::setCameraIntrinsics(const CameraIntrinsics& intrinsics) {
+  const std::string error = intrinsics.validate();
+  if (!error.empty()) {
+    impl_->reject(RejectReason::kBadCameraInfo, InputStream::kCameraInfo, error + "; ignored");
+    return false;
+  }
+  impl_->intrinsics = intrinsics;
+  return true;
+}
+
+void CalibrationPipeline::addFrame(const CameraFrame& frame) {
+  Impl& s = *impl_;
+  const InputStream stream = frame.R_target_cam ? InputStream::kCameraPose : InputStream::kImage;
+  if (!std::isfinite(frame.stamp_s)) {
+    s.reject(RejectReason::kNonFinite, stream, "stamp is not finite; frame dropped");
+    return;
+  }
+  if (frame.R_target_cam) {
+    if (!isRotationMatrix(*frame.R_target_cam, 1e-6)) {
+      s.reject(RejectReason::kNonFinite, stream, "not a finite unit rotation; dropped");
+      return;
+    }
+  } else if (frame.mono8.empty() || frame.mono8.type() != CV_8UC1) {
+    s.reject(RejectReason::kBadImage, stream, "empty or not mono8 after conversion; frame dropped");
+    return;
+  }
+  if (!s.checkStamp(frame.stamp_s, &s.last_frame_stamp, stream)) return;
+  ++s.num_frames;
+  s.frame_queue.push_back(frame);
+  // Without IMU data frames cannot be judged: keep a bounded backlog only.
+  while (s.frame_queue.size() > 1 &&
+         s.frame_queue.front().stamp_s < frame.stamp_s - s.settings.frame_queue_s) {
+    s.frame_queue.pop_front();
+    ++s.frames_dropped;
+  }
+  s.processFrames(false);
+}
+
+void CalibrationPipeline::Impl::processFrames(bool flush) {
+  const double settle = 0.5 * settings.stationary.window_s + settings.frame_margin_s;
+  while (!frame_queue.empty()) {
+    const CameraFrame& frame = frame_queue.front();
+    if (!flush && frame.stamp_s > last_imu_stamp - settle) return;  // IMU not far enough yet
+    const std::optional<double> rest_since = stationary.restSince();
+    const bool at_rest = stationary.atRest() && rest_since &&
+                         frame.stamp_s >= *rest_since + settle && frame.stamp_s <= last_imu_stamp;
+    if (at_rest) processFrame(frame);
+    frame_queue.pop_front();
+  }
+}
+
+void CalibrationPipeline::Impl::processFrame(const CameraFrame& frame) {
+  // Detection is the expensive part: only a few, spaced frames per rest.
+  const std::optional<double> rest_since = stationary.restSince();
+  if (rest_since != misses_rest) {  // a new rest: the target may be in view again
+    misses_rest = rest_since;
+    misses_in_a_row = 0;
+  }
+  const double interval = misses_in_a_row >= PipelineSettings::kMissesBeforeBackoff
+                              ? settings.missed_frame_interval_s
+                              : settings.min_frame_interval_s;
+  if (frame.stamp_s - last_detection_stamp < interval) return;
+  int in_this_rest = 0;
+  for (const auto& d : detections) in_this_rest += (rest_since && d.stamp_s >= *rest_since);
+  if (in_this_rest >= settings.max_frames_per_pose) return;
+  if (frame.R_target_cam) {  // given orientation: nothing to detect
+    last_detection_stamp = frame.stamp_s;
+    CameraPose given;
+    given.R_target_cam = *frame.R_target_cam;
+    detections.push_back({frame.stamp_s, given});
+    return;
+  }
+  if (!intrinsics) {
+    ++frames_without_intrinsics;
+    return;
+  }
+  if (frame.mono8.cols != intrinsics->width || frame.mono8.rows != intrinsics->height) {
+    std::ostringstream out;
+    out << frame.mono8.cols << "x" << frame.mono8.rows << " differs from the camera info's "
+        << intrinsics->width << "x" << intrinsics->height << "; frame dropped";
+    reject(RejectReason::kBadImage, InputStream::kImage, out.str());
+    return;
+  }
+  last_detection_stamp = frame.stamp_s;
+  ++num_detected;
+  const Eigen::Matrix3d* hint = poses.empty() ? nullptr : &poses.back().R_target_cam;
+  TargetObservation observation;
+  if (!detector.detect(frame.mono8, &observation, hint)) {
+    ++misses_in_a_row;
+    std::ostringstream out;
+    out << "image at " << frame.stamp_s << " s (at rest): " << target.describe() << " not found";
+    reject(RejectReason::kTargetNotFound, InputStream::kImage, out.str());
+    return;
+  }
+  std::string why;
+  const auto pose = estimateCameraPose(observation, target, *intrinsics, settings.pose, &why);
+  if (!pose) {
+    reject(RejectReason::kPoseRejected, InputStream::kImage,
+           "image at " + std::to_string(frame.stamp_s) + " s: " + why);
+    return;
+  }
+  misses_in_a_row = 0;
+  detections.push_back({frame.stamp_s, *pose});
+}
+
+void CalibrationPipeline::finish() {
+  impl_->processFrames(true);
+  if (auto segment = impl_->stationary.flush()) impl_->onSegment(*segment);
+}
+
+AlignmentResult CalibrationPipeline::solve() const { return impl_->solve(); }
+
+void CalibrationPipeline::reset(bool clear_counts) {
+  const RejectionCounts counts = impl_->rejections;
+  const std::uint64_t n_imu = impl_->num_imu, n_mag = impl_->num_mag, n_frames = impl_->num_frames,
+                      n_detected = impl_->num_detected, n_gaps = impl_->imu_gaps;
+  const std::optional<CameraIntrinsics> intrinsics = impl_->intrinsics;
+  impl_ = std::make_unique<Impl>(impl_->target, impl_->settings, impl_->callbacks);
+  impl_->intrinsics = intrinsics;  // configuration, not data: kept
+  if (!clear_counts) {
+    impl_->rejections = counts;
+    impl_->num_imu = n_imu;
+    impl_->num_mag = n_mag;
+    impl_->num_frames = n_frames;
+    impl_->num_detected = n_detected;
+    impl_->imu_gaps = n_gaps;
+  }
+}
+
+void CalibrationPipeline::keepNewestPoses(std::size_t count) { impl_->window.keepNewest(count); }
+std::size_t CalibrationPipeline::windowSize() const { return impl_->window.size(); }
+
+const std::vector<StationaryPose>& CalibrationPipeline::poses() const { return impl_->poses; }
+RotationPairs CalibrationPipeline::windowPairs() const { return impl_->window.makePairs(); }
+const std::vector<RejectedPose>& CalibrationPipeline::rejectedPoses() const {
+  return impl_->rejected;
+}
+const std::vector<StationarySegment>& CalibrationPipeline::segments() const {
+  return impl_->segments;
+}
+const RejectionCounts& CalibrationPipeline::rejections() const { return impl_->rejections; }
+std::uint64_t CalibrationPipeline::imuGaps() const { return impl_->imu_gaps; }
+std::size_t CalibrationPipeline::posesTotal() const { return impl_->poses_total; }
+std::size_t CalibrationPipeline::restsTotal() const { return impl_->rests_total; }
+
+PipelineBufferSizes CalibrationPipeline::bufferSizes() const {
+  const Impl& s = *impl_;
+  PipelineBufferSizes sizes;
+  sizes.imu = s.imu_buffer.size();
+  sizes.mag = s.mag_buffer.size();
+  sizes.frame_queue = s.frame_queue.size();
+  sizes.detections = s.detections.size();
+  sizes.poses = s.poses.size();
+  sizes.rests = s.segments.size();
+  sizes.rejected_rests = s.rejected.size();
+  sizes.window = s.window.size();
+  return sizes;
+}
+std::optional<AlignmentResult> CalibrationPipeline::lastResult() const {
+  return impl_->last_result;
+}
+std::uint64_t CalibrationPipeline::imuSamples() const { return impl_->num_imu; }
+std::uint64_t CalibrationPipeline::magneticSamples() const { return impl_->num_mag; }
+std::uint64_t CalibrationPipeline::frames() const { return impl_->num_frames; }
+std::uint64_t CalibrationPipeline::framesDetected() const { return impl_->num_detected; }
+bool CalibrationPipeline::hasIntrinsics() const { return impl_->intrinsics.has_value(); }
+const PipelineSettings& CalibrationPipeline::settings() const { return impl_->settings; }
+
+}  // namespace camera_imu_alignment

@@ -1,0 +1,81 @@
+// Private state of CalibrationPipeline, shared by its two source files (input side:
+// calibration_pipeline.cpp; segment -> pose assembly: pose_assembly.cpp). Not installed.
+#pragma once
+
+#include <deque>
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+
+namespace camera_imu_alignment {
+
+/// Camera pose of one frame taken at rest.
+struct FrameDetection {
+  double stamp_s = 0.0;
+  CameraPose pose;
+};
+
+struct CalibrationPipeline::Impl {
+  Impl(const TargetDescription& target, const PipelineSettings& settings,
+       PipelineCallbacks callbacks);
+
+  // --- configuration
+  TargetDescription target;
+  PipelineSettings settings;
+  PipelineCallbacks callbacks;
+  TargetDetector detector;
+  std::vector<Eigen::Matrix3d> symmetries;  ///< detector.symmetries()
+
+  // --- streaming state
+  StationaryDetector stationary;
+  MagneticDisturbanceDetector disturbance;
+  std::optional<CameraIntrinsics> intrinsics;
+  RejectionCounts rejections;
+  double last_imu_stamp = -std::numeric_limits<double>::infinity();
+  double last_mag_stamp = -std::numeric_limits<double>::infinity();
+  double last_frame_stamp = -std::numeric_limits<double>::infinity();
+  std::deque<ImuSample> imu_buffer;        ///< since the end of the last segment (gyro chain)
+  bool imu_buffer_truncated = false;       ///< samples needed by the next integration were dropped
+  std::deque<MagneticSample> mag_buffer;   ///< calibrated field, tesla
+  std::deque<CameraFrame> frame_queue;     ///< waiting until the IMU shows rest or motion
+  std::vector<FrameDetection> detections;  ///< frames at rest with a camera pose
+  double last_detection_stamp = -std::numeric_limits<double>::infinity();
+  int misses_in_a_row = 0;            ///< failed detections in a row at the rest misses_rest
+  std::optional<double> misses_rest;  ///< start of the rest they belong to
+  std::uint64_t num_imu = 0, num_mag = 0, num_frames = 0, num_detected = 0;
+  std::uint64_t frames_without_intrinsics = 0, frames_dropped = 0;
+
+  // --- IMU orientation chain (see the rule in calibration_pipeline.h)
+  bool chain_valid = false;
+  StationarySegment chain_segment;  ///< the last segment, pose or not
+  Eigen::Matrix3d chain_R_world_imu = Eigen::Matrix3d::Identity();
+  std::optional<Eigen::Matrix3d> chain_R_world_imu_accel_mag;  ///< of chain_segment
+  int group = 0;
+  bool group_magnetic = false;  ///< the current group's heading comes from the magnetometer
+  bool group_message = false;   ///< the current group's frame is the IMU's own (kMessage)
+
+  // --- results
+  std::vector<StationarySegment> segments;
+  std::vector<StationaryPose> poses;
+  std::vector<RejectedPose> rejected;
+  PoseWindow window;
+  std::optional<AlignmentResult> last_result;
+
+  std::size_t poses_total = 0, rests_total = 0;
+  std::uint64_t imu_gaps = 0;  ///< IMU stamp gaps longer than settings.stationary.max_gap_s
+
+  void reject(RejectReason reason, InputStream stream, const std::string& detail);
+  /// Stamp order check shared by the three streams; false (counted) when rejected.
+  bool checkStamp(double stamp, double* last, InputStream stream);
+  /// Processes queued frames whose rest/motion status the IMU has settled.
+  void processFrames(bool flush);
+  void processFrame(const CameraFrame& frame);
+  /// A stationary segment ended: build the pose (pose_assembly.cpp).
+  void onSegment(const StationarySegment& segment);
+  void solveAndReport();
+  AlignmentResult solve() const;
+};
+
+}  // namespace camera_imu_alignment

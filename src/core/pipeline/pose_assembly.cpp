@@ -1,0 +1,282 @@
+// CalibrationPipeline, pose side: a stationary segment ended -> IMU orientation (gyro chain /
+// accelerometer + magnetometer, rule in calibration_pipeline.h), camera orientation (robust
+// average of the frames at rest), pose window, solve.
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "calibration_pipeline_impl.h"
+#include "camera_imu_alignment/solver/rotation_average.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
+
+namespace camera_imu_alignment {
+namespace {
+
+/// The field of a segment: mean of the samples inside it and how much its direction wandered
+/// (fieldDirectionScatterDeg).
+struct SegmentField {
+  int count = 0;
+  Eigen::Vector3d mean_t = Eigen::Vector3d::Zero();
+  double scatter_deg = 0.0;
+};
+
+SegmentField segmentField(const std::deque<MagneticSample>& samples, double start_s, double end_s) {
+  SegmentField field;
+  std::vector<Eigen::Vector3d> inside;
+  for (const auto& s : samples) {
+    if (s.stamp_s < start_s || s.stamp_s > end_s) continue;
+    field.mean_t += s.field_t;
+    inside.push_back(s.field_t);
+  }
+  field.count = static_cast<int>(inside.size());
+  if (field.count == 0) return field;
+  field.mean_t /= field.count;
+  field.scatter_deg = fieldDirectionScatterDeg(inside);
+  return field;
+}
+
+constexpr int kMinFieldSamples = 5;
+
+/// Mean of the IMU's own orientations in [start_s, end_s] (sign-aligned quaternion average); none
+/// with fewer than 5 samples carrying one.
+std::optional<Eigen::Matrix3d> messageOrientation(const std::deque<ImuSample>& samples,
+                                                  double start_s, double end_s) {
+  Eigen::Vector4d sum = Eigen::Vector4d::Zero(), first = Eigen::Vector4d::Zero();
+  int count = 0;
+  for (const auto& s : samples) {
+    if (!s.q_world_imu || s.stamp_s < start_s || s.stamp_s > end_s) continue;
+    Eigen::Vector4d q = s.q_world_imu->coeffs();
+    if (count == 0) first = q;
+    if (q.dot(first) < 0.0) q = -q;
+    sum += q;
+    ++count;
+  }
+  if (count < 5 || !(sum.norm() > 0.0)) return std::nullopt;
+  sum.normalize();
+  return Eigen::Quaterniond(sum(3), sum(0), sum(1), sum(2)).toRotationMatrix();
+}
+
+std::string fmt(double value, int precision = 2) {
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(precision);
+  out << value;
+  return out.str();
+}
+
+/// The board may look the same turned (TargetDetector::symmetries): among the readings
+/// S * R_target_cam, the right one turns the camera by the same angle as the IMU since the earlier
+/// poses of the group (a rotation angle does not depend on the frame). Keeps the detector's reading
+/// when no earlier pose can tell or the best two readings agree within `kSymmetryMarginDeg`.
+constexpr double kSymmetryMarginDeg = 2.0;
+constexpr std::size_t kSymmetryReferencePoses = 5;
+
+Eigen::Matrix3d resolveSymmetry(const Eigen::Matrix3d& R_target_cam,
+                                const Eigen::Matrix3d& R_world_imu, int group,
+                                const std::vector<StationaryPose>& poses,
+                                const std::vector<Eigen::Matrix3d>& symmetries) {
+  if (symmetries.empty()) return R_target_cam;
+  std::vector<const StationaryPose*> references;
+  for (auto it = poses.rbegin(); it != poses.rend(); ++it) {
+    if (it->group != group) break;  // groups are contiguous
+    references.push_back(&*it);
+    if (references.size() == kSymmetryReferencePoses) break;
+  }
+  if (references.empty()) return R_target_cam;
+  std::vector<Eigen::Matrix3d> readings{R_target_cam};
+  for (const auto& S : symmetries) readings.push_back(S * R_target_cam);
+  std::vector<double> cost(readings.size(), 0.0);
+  for (std::size_t k = 0; k < readings.size(); ++k) {
+    for (const StationaryPose* p : references) {
+      const double camera = rotationAngle(p->R_target_cam.transpose() * readings[k]);
+      const double imu = rotationAngle(p->R_world_imu.transpose() * R_world_imu);
+      cost[k] += std::abs(camera - imu) / static_cast<double>(references.size());
+    }
+  }
+  std::vector<std::size_t> order(readings.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return cost[a] < cost[b]; });
+  if (rad2deg(cost[order[1]] - cost[order[0]]) < kSymmetryMarginDeg) return R_target_cam;
+  return readings[order[0]];
+}
+
+/// Appends, dropping the oldest entry beyond CalibrationPipeline::kHistoryLimit.
+template <typename T>
+void pushBounded(std::vector<T>* history, const T& item) {
+  if (history->size() >= CalibrationPipeline::kHistoryLimit) history->erase(history->begin());
+  history->push_back(item);
+}
+
+}  // namespace
+
+void CalibrationPipeline::Impl::onSegment(const StationarySegment& segment) {
+  pushBounded(&segments, segment);
+  ++rests_total;
+  StationaryPose pose;
+  pose.index = static_cast<int>(poses_total);
+  pose.start_s = segment.start_s;
+  pose.end_s = segment.end_s;
+  pose.gyro_bias_rad_s = segment.gyro_bias_rad_s;
+
+  // --- Magnetometer: usable when there are samples, the attitude is defined and it is undisturbed.
+  const SegmentField field = segmentField(mag_buffer, segment.start_s, segment.end_s);
+  if (field.count < kMinFieldSamples) {
+    pose.magnetometer_note = field.count == 0 && num_mag == 0
+                                 ? "no magnetometer data"
+                                 : "only " + std::to_string(field.count) + " field samples";
+  } else {
+    const AttitudeFromVectors attitude =
+        attitudeFromAccelMag(segment.mean_accel_m_s2, field.mean_t, settings.accel_weight);
+    std::string why;
+    if (!attitude.valid) {
+      pose.magnetometer_note = "field parallel to gravity or zero";
+    } else if (disturbance.check(attitude.field_norm_t, attitude.dip_deg, field.scatter_deg,
+                                 &why)) {
+      pose.magnetometer_note = "disturbed: " + why;
+    } else {
+      pose.magnetometer_usable = true;
+      pose.R_world_imu_accel_mag = attitude.R_world_imu;
+    }
+  }
+
+  // --- Gyro since the previous segment (bias: mean of the two rests' gyro means).
+  if (chain_valid) {
+    const double t0 = chain_segment.end_s, t1 = segment.start_s;
+    const bool covered = !imu_buffer.empty() && !imu_buffer_truncated &&
+                         imu_buffer.front().stamp_s <= t0 + settings.stationary.max_gap_s &&
+                         t1 - t0 <= settings.max_gyro_span_s;
+    Eigen::Matrix3d R_prev_cur;
+    const Eigen::Vector3d bias = 0.5 * (chain_segment.gyro_bias_rad_s + segment.gyro_bias_rad_s);
+    if (covered && integrateGyro(std::vector<ImuSample>(imu_buffer.begin(), imu_buffer.end()), bias,
+                                 t0, t1, &R_prev_cur, settings.stationary.max_gap_s)) {
+      pose.R_imu_previous_imu_gyro = projectToSO3(R_prev_cur);
+    }
+    if (pose.R_imu_previous_imu_gyro && pose.R_world_imu_accel_mag && chain_R_world_imu_accel_mag) {
+      const Eigen::Matrix3d B_mag =
+          chain_R_world_imu_accel_mag->transpose() * *pose.R_world_imu_accel_mag;
+      pose.gyro_mag_difference_deg =
+          rad2deg(rotationAngle(pose.R_imu_previous_imu_gyro->transpose() * B_mag));
+    }
+  }
+
+  // --- The orientation used (rule in calibration_pipeline.h).
+  const bool prefer_mag = settings.imu_orientation == ImuOrientationSource::kMagnetometer;
+  const std::optional<Eigen::Matrix3d> R_message =
+      settings.imu_orientation == ImuOrientationSource::kMessage
+          ? messageOrientation(imu_buffer, segment.start_s, segment.end_s)
+          : std::nullopt;
+  if (R_message) {
+    if (chain_valid && !group_message) ++group;  // the sensor's frame, unrelated to ours
+    group_message = true;
+    group_magnetic = false;
+    pose.R_world_imu = *R_message;
+    pose.imu_source = "message";
+  } else if (pose.R_imu_previous_imu_gyro &&
+             !(prefer_mag && pose.magnetometer_usable && group_magnetic)) {
+    pose.R_world_imu = projectToSO3(chain_R_world_imu * *pose.R_imu_previous_imu_gyro);
+    pose.imu_source = "gyro";
+  } else if (pose.magnetometer_usable) {
+    if (chain_valid && !group_magnetic) ++group;  // the old chain's heading was arbitrary
+    group_magnetic = true;
+    group_message = false;
+    pose.R_world_imu = *pose.R_world_imu_accel_mag;
+    pose.imu_source = "accel_mag";
+  } else {
+    if (chain_valid) ++group;  // heading unknown relative to everything before
+    group_magnetic = false;
+    group_message = false;
+    pose.R_world_imu = attitudeFromAccel(segment.mean_accel_m_s2);
+    pose.imu_source = "accel_only";
+  }
+  pose.group = group;
+  chain_valid = true;
+  chain_segment = segment;
+  chain_R_world_imu = pose.R_world_imu;
+  chain_R_world_imu_accel_mag = pose.R_world_imu_accel_mag;
+  imu_buffer_truncated = false;
+  while (!imu_buffer.empty() && imu_buffer.front().stamp_s < segment.end_s) imu_buffer.pop_front();
+  while (!mag_buffer.empty() && mag_buffer.front().stamp_s < segment.end_s) mag_buffer.pop_front();
+
+  // --- Camera: the frames inside the segment, margins off both ends.
+  std::vector<Eigen::Matrix3d> rotations;
+  double reprojection_sum = 0.0;
+  const double lo = segment.start_s + settings.frame_margin_s;
+  const double hi = segment.end_s - settings.frame_margin_s;
+  for (const auto& d : detections) {
+    if (d.stamp_s < lo || d.stamp_s > hi) continue;
+    rotations.push_back(d.pose.R_target_cam);
+    reprojection_sum += d.pose.reprojection_rms_px;
+    pose.p_target_cam = d.pose.p_target_cam;
+  }
+  std::vector<FrameDetection> later;
+  for (const auto& d : detections) {
+    if (d.stamp_s > segment.end_s) later.push_back(d);
+  }
+  detections.swap(later);
+
+  RejectedPose rejection{segment.start_s, segment.end_s, ""};
+  if (static_cast<int>(rotations.size()) < settings.min_frames_per_pose) {
+    if (!intrinsics) {
+      rejection.reason = "no camera info received yet";
+    } else if (num_frames == 0) {
+      rejection.reason = "no camera data";
+    } else {
+      rejection.reason = "target seen in " + std::to_string(rotations.size()) + " frame(s), " +
+                         std::to_string(settings.min_frames_per_pose) + " needed";
+    }
+  } else {
+    const RotationAverage average =
+        averageRotations(rotations, 4.0 * settings.max_camera_spread_deg);
+    if (average.num_inliers < settings.min_frames_per_pose ||
+        average.spread_rms_deg > settings.max_camera_spread_deg) {
+      rejection.reason = "camera orientation scatter " + fmt(average.spread_rms_deg) +
+                         " deg over " + std::to_string(rotations.size()) + " frames (limit " +
+                         fmt(settings.max_camera_spread_deg) + ")";
+    } else {
+      pose.R_target_cam =
+          resolveSymmetry(average.mean, pose.R_world_imu, pose.group, poses, symmetries);
+      pose.num_frames = average.num_inliers;
+      pose.camera_spread_deg = average.spread_rms_deg;
+      pose.reprojection_rms_px = reprojection_sum / static_cast<double>(rotations.size());
+    }
+  }
+  if (!rejection.reason.empty()) {
+    pushBounded(&rejected, rejection);
+    if (callbacks.on_pose_rejected) callbacks.on_pose_rejected(rejection);
+    return;
+  }
+
+  pushBounded(&poses, pose);
+  ++poses_total;
+  PoseOrientation orientation;
+  orientation.stamp_s = 0.5 * (pose.start_s + pose.end_s);
+  orientation.R_target_cam = pose.R_target_cam;
+  orientation.R_world_imu = pose.R_world_imu;
+  orientation.group = pose.group;
+  window.add(orientation);
+  if (callbacks.on_pose) callbacks.on_pose(pose);
+  if (static_cast<int>(window.size()) >= settings.min_poses_to_solve) solveAndReport();
+}
+
+AlignmentResult CalibrationPipeline::Impl::solve() const {
+  const RotationPairs pairs = window.makePairs();
+  if (pairs.empty()) {
+    AlignmentResult result;
+    result.status = SolveStatus::kBadInput;
+    result.message = "no pairs yet: " + std::to_string(window.size()) +
+                     " stationary pose(s) in the window, at least 2 of one group needed";
+    return result;
+  }
+  return solveAlignment(pairs, settings.solver);
+}
+
+void CalibrationPipeline::Impl::solveAndReport() {
+  AlignmentResult result = solve();
+  if (result.status == SolveStatus::kBadInput) return;
+  last_result = result;
+  if (callbacks.on_result) callbacks.on_result(result);
+}
+
+}  // namespace camera_imu_alignment

@@ -1,0 +1,48 @@
+#include "camera_imu_alignment/solver/pose_window.h"
+
+#include <algorithm>
+
+#include "camera_imu_alignment/solver/rotation_math.h"
+
+namespace camera_imu_alignment {
+
+PoseWindow::PoseWindow(std::size_t max_poses) : max_poses_(std::max<std::size_t>(2, max_poses)) {}
+
+bool PoseWindow::add(const PoseOrientation& pose) {
+  if (!isRotationMatrix(pose.R_target_cam, 1e-6) || !isRotationMatrix(pose.R_world_imu, 1e-6)) {
+    return false;
+  }
+  poses_.push_back(pose);
+  while (poses_.size() > max_poses_) poses_.pop_front();
+  return true;
+}
+
+void PoseWindow::clear() { poses_.clear(); }
+
+void PoseWindow::keepNewest(std::size_t count) {
+  while (poses_.size() > count) poses_.pop_front();
+}
+
+RotationPairs PoseWindow::makePairs() const {
+  return makeAllPairs(std::vector<PoseOrientation>(poses_.begin(), poses_.end()));
+}
+
+RotationPairs makeAllPairs(const std::vector<PoseOrientation>& poses) {
+  RotationPairs pairs;
+  const int P = static_cast<int>(poses.size());
+  pairs.reserve(static_cast<size_t>(P) * (P > 0 ? P - 1 : 0) / 2);
+  for (int k = 0; k < P; ++k) {
+    for (int t = k + 1; t < P; ++t) {
+      if (poses[k].group != poses[t].group) continue;
+      RotationPair pair;
+      pair.A_cam = poses[k].R_target_cam.transpose() * poses[t].R_target_cam;
+      pair.B_imu = poses[k].R_world_imu.transpose() * poses[t].R_world_imu;
+      pair.pose_k = k;
+      pair.pose_t = t;
+      pairs.push_back(pair);
+    }
+  }
+  return pairs;
+}
+
+}  // namespace camera_imu_alignment
