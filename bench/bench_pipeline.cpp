@@ -39,6 +39,7 @@
 #include "camera_imu_alignment/simulation/target.h"
 #include "camera_imu_alignment/inertial/stationary_detector.h"
 #include "camera_imu_alignment/vision/target_description.h"
+#include "camera_imu_alignment/vision/camera_pose.h"
 #include "camera_imu_alignment/vision/target_detector.h"
 
 namespace cia = camera_imu_alignment;

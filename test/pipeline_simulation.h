@@ -67,7 +67,7 @@ inline PipelineRun feedPipeline(std::unique_ptr<simulation::SimulationRun> simul
   callbacks.on_reject = [details](RejectReason reason, InputStream stream,
                                   const std::string& detail) {
     if (details->size() < 200) {
-      details->push_back(std::string(inputStreamName(stream)) + ": " + rejectReasonName(reason) +
+      details->push_back(std::string(toString(stream)) + ": " + toString(reason) +
                          ": " + detail);
     }
   };

@@ -76,7 +76,7 @@ TEST(CalibrationPipeline, NominalRunFindsEveryPoseAndTheMounting) {
     // Angle random walk 1.87e-4 rad/s/sqrt(Hz) over ~4 s between rests plus the rest-mean bias
     // error: ~0.04 deg RMS (3 axes); 0.1 deg is about 2.5 sigma.
     EXPECT_LT(test::angleBetweenDeg(B, B_true), 0.1) << "poses " << k - 1 << ", " << k;
-    EXPECT_EQ(poses[k].imu_source, "gyro");
+    EXPECT_EQ(poses[k].imu_source, PoseImuSource::kGyro);
     ASSERT_TRUE(poses[k].gyro_mag_difference_deg.has_value());
     EXPECT_LT(*poses[k].gyro_mag_difference_deg, 2.0);
   }
@@ -163,7 +163,7 @@ TEST(CalibrationPipeline, ImuOwnOrientationIsUsedWhenAsked) {
   const auto pipeline = runWithoutImages(run, settings, true);
   ASSERT_EQ(pipeline->poses().size(), run.trajectory.poses().size());
   for (const auto& pose : pipeline->poses()) {
-    EXPECT_EQ(pose.imu_source, "message");
+    EXPECT_EQ(pose.imu_source, PoseImuSource::kMessage);
     EXPECT_EQ(pose.group, 0);
     const double t = 0.5 * (pose.start_s + pose.end_s);
     EXPECT_LT(test::angleBetweenDeg(pose.R_world_imu, run.trajectory.at(t).R_world_imu()), 0.05);
@@ -175,7 +175,7 @@ TEST(CalibrationPipeline, ImuOwnOrientationIsUsedWhenAsked) {
   // Without orientations in the samples, the rule falls back to the gyro chain.
   const auto fallback = runWithoutImages(run, settings, false);
   ASSERT_GE(fallback->poses().size(), 2u);
-  EXPECT_EQ(fallback->poses()[1].imu_source, "gyro");
+  EXPECT_EQ(fallback->poses()[1].imu_source, PoseImuSource::kGyro);
 }
 
 TEST(CalibrationPipeline, CameraTimeOffsetsOfTensOfMillisecondsChangeNothing) {
@@ -192,9 +192,9 @@ TEST(CalibrationPipeline, WithoutMagnetometerTheGyroCarriesTheHeading) {
   const auto r = test::runPipeline(scenario("no_magnetometer", 7));
   const auto& poses = r.pipeline->poses();
   ASSERT_GE(poses.size(), 10u);
-  EXPECT_EQ(poses.front().imu_source, "accel_only");
+  EXPECT_EQ(poses.front().imu_source, PoseImuSource::kAccelOnly);
   for (std::size_t k = 1; k < poses.size(); ++k) {
-    EXPECT_EQ(poses[k].imu_source, "gyro");
+    EXPECT_EQ(poses[k].imu_source, PoseImuSource::kGyro);
     EXPECT_EQ(poses[k].group, 0);
     EXPECT_FALSE(poses[k].magnetometer_usable);
   }
@@ -217,7 +217,7 @@ TEST(CalibrationPipeline, DisturbedFieldIsFlaggedAndNeverUsed) {
           c.mag_disturbance_poses.end();
       if (disturbed) {
         EXPECT_FALSE(pose.magnetometer_usable) << "hold " << hold;
-        EXPECT_NE(pose.imu_source, "accel_mag");
+        EXPECT_NE(pose.imu_source, PoseImuSource::kAccelMag);
         ++flagged;
       } else if (source == ImuOrientationSource::kMagnetometer && pose.index > 0) {
         EXPECT_TRUE(pose.magnetometer_usable) << "hold " << hold << ": " << pose.magnetometer_note;

@@ -2,6 +2,7 @@
 // (Kalibr, OpenVINS, VINS, tf2) to 1e-8, the summary text, and the PNG page for realistic, empty
 // and NaN inputs.
 #include "camera_imu_alignment/io/calibration_report.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>

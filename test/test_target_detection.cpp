@@ -20,6 +20,7 @@
 #include "camera_imu_alignment/simulation/renderer.h"
 #include "camera_imu_alignment/simulation/simulation_run.h"
 #include "camera_imu_alignment/vision/target_description.h"
+#include "camera_imu_alignment/vision/camera_pose.h"
 #include "camera_imu_alignment/vision/target_detector.h"
 
 namespace camera_imu_alignment {

@@ -11,8 +11,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "alignment_wrapper_impl.h"
+#include "camera_imu_alignment/io/default_frames.h"
 #include "camera_imu_alignment/AlignmentStatus.h"
-#include "camera_imu_alignment/io/calibration_report.h"
 #include "camera_imu_alignment/io/input_error.h"
 #include "camera_imu_alignment/io/result_yaml.h"
 #include "camera_imu_alignment/ros/broadcast_gate.h"
@@ -44,13 +44,13 @@ void AlignmentWrapper::Impl::advertise() {
 std::string AlignmentWrapper::Impl::cameraFrame() const {
   if (!settings.camera_frame.empty()) return settings.camera_frame;
   if (!input->cameraFrame().empty()) return input->cameraFrame();
-  return saved_camera_frame.empty() ? "camera_optical_frame" : saved_camera_frame;
+  return frameOr(saved_camera_frame, kDefaultCameraFrame);
 }
 
 std::string AlignmentWrapper::Impl::imuFrame() const {
   if (!settings.imu_frame.empty()) return settings.imu_frame;
   if (!input->imuFrame().empty()) return input->imuFrame();
-  return saved_imu_frame.empty() ? "imu_link" : saved_imu_frame;
+  return frameOr(saved_imu_frame, kDefaultImuFrame);
 }
 
 void AlignmentWrapper::Impl::onResult(const AlignmentResult& result) {
@@ -176,7 +176,7 @@ void AlignmentWrapper::Impl::publishStatus() {
     s.last_pose_start = ros::Time(last_pose->start_s);
     s.last_pose_end = ros::Time(last_pose->end_s);
     s.last_pose_frames = static_cast<std::uint32_t>(last_pose->num_frames);
-    s.last_pose_imu_source = last_pose->imu_source;
+    s.last_pose_imu_source = toString(last_pose->imu_source);
   }
   status_pub.publish(s);
 }
@@ -348,7 +348,7 @@ void AlignmentWrapper::Impl::diagnose(diagnostic_updater::DiagnosticStatusWrappe
   status.add("rejected inputs", rejections.summary());
   for (int i = 0; i < static_cast<int>(RejectReason::kCount); ++i) {
     const auto reason = static_cast<RejectReason>(i);
-    status.add(std::string("rejected ") + rejectReasonName(reason), rejections.count(reason));
+    status.add(std::string("rejected ") + toString(reason), rejections.count(reason));
   }
 }
 

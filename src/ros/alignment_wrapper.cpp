@@ -62,12 +62,12 @@ std::string AlignmentWrapper::Impl::topicOf(InputStream stream) const {
     case InputStream::kCameraPose:
       return camera_pose_sub.getTopic();
   }
-  return inputStreamName(stream);
+  return toString(stream);
 }
 
 bool AlignmentWrapper::Impl::acceptStamp(const std_msgs::Header& header, InputStream stream) {
   if (!input->checkStamp(header, stream)) return false;
-  const double jump_s = clock.update(inputStreamName(stream), header.stamp.toSec());
+  const double jump_s = clock.update(toString(stream), header.stamp.toSec());
   if (jump_s > 0.0) {
     ROS_WARN(
         "camera_imu_alignment: %s: time jumped back by %.1f s (bag loop or restarted "
@@ -153,7 +153,7 @@ void AlignmentWrapper::Impl::onPose(const StationaryPose& pose) {
   last_pose = pose;
   capture_armed = false;
   ROS_INFO("camera_imu_alignment: stationary pose %d (%.1f s, %d frames, IMU from %s)", pose.index,
-           pose.end_s - pose.start_s, pose.num_frames, pose.imu_source.c_str());
+           pose.end_s - pose.start_s, pose.num_frames, toString(pose.imu_source));
   // Remount check: the new pose's pairs with the rest of the window against the broadcast estimate.
   if (broadcast_R) {
     const RotationPairs pairs = pipeline->windowPairs();
@@ -209,7 +209,7 @@ void AlignmentWrapper::Impl::onReject(RejectReason reason, InputStream stream,
       unwarned > 0 ? " (+" + std::to_string(unwarned) + " more since the last such warning)" : "";
   unwarned = 0;
   ROS_WARN("camera_imu_alignment: %s: rejected (%s): %s%s", topicOf(stream).c_str(),
-           rejectReasonName(reason), detail.c_str(), more.c_str());
+           toString(reason), detail.c_str(), more.c_str());
 }
 
 }  // namespace camera_imu_alignment

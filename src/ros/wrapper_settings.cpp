@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <sstream>
 
 #include "camera_imu_alignment/io/input_error.h"
@@ -14,15 +13,11 @@
 namespace camera_imu_alignment {
 namespace {
 
-struct Key {
-  std::string name;
-  std::function<void(const YAML::Node&, WrapperSettings*)> read;
-};
+using Key = SettingKey<WrapperSettings>;
 
 template <typename T>
 Key field(const std::string& name, T WrapperSettings::*member) {
-  return {name,
-          [member](const YAML::Node& node, WrapperSettings* s) { s->*member = node.as<T>(); }};
+  return fieldKey<T, WrapperSettings>(name, [member](WrapperSettings* s) { return &(s->*member); });
 }
 
 const std::vector<Key>& keys() {
@@ -94,36 +89,41 @@ std::string check(const WrapperSettings& s) {
 }  // namespace
 
 const std::vector<std::string>& wrapperKeys() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> n;
-    for (const auto& key : keys()) n.push_back(key.name);
-    return n;
-  }();
+  static const std::vector<std::string> names = keyNames(keys());
   return names;
 }
 
-void parseSettings(const std::string& yaml_text, const std::string& source,
-                   WrapperSettings* wrapper, PipelineSettings* pipeline) {
-  // Pipeline keys first: its reader rejects unknown keys, ours are passed as known.
-  parsePipelineConfig(yaml_text, source, pipeline, wrapperKeys());
-  const YAML::Node root = YAML::Load(yaml_text);
+void parseSettings(const YAML::Node& root, const std::string& source, WrapperSettings* wrapper,
+                   PipelineSettings* pipeline) {
+  // One pass over the map and the two tables: a key is the wrapper's or else the pipeline's
+  // (whose reader names an unknown key).
   WrapperSettings updated = *wrapper;
+  PipelineSettings updated_pipeline = *pipeline;
   if (root.IsMap()) {
     for (const auto& entry : root) {
       const std::string name = entry.first.as<std::string>();
-      const auto it =
-          std::find_if(keys().begin(), keys().end(), [&](const Key& k) { return k.name == name; });
-      if (it == keys().end()) continue;  // a pipeline key
+      const Key* key = findKey(keys(), name);
+      if (!key) {
+        readPipelineKey(source, name, entry.second, &updated_pipeline);
+        continue;
+      }
       try {
-        it->read(entry.second, &updated);
+        key->read(entry.second, &updated);
       } catch (const YAML::Exception& e) {
         throw InputError(source + ": parameter '" + name + "': " + e.msg);
       }
     }
   }
+  checkPipelineSettings(source, updated_pipeline);
   const std::string error = check(updated);
   if (!error.empty()) throw InputError(source + ": " + error);
   *wrapper = updated;
+  *pipeline = updated_pipeline;
+}
+
+void parseSettings(const std::string& yaml_text, const std::string& source,
+                   WrapperSettings* wrapper, PipelineSettings* pipeline) {
+  parseSettings(parseSettingsYaml(yaml_text, source), source, wrapper, pipeline);
 }
 
 void readSettings(const ros::NodeHandle& private_nh, WrapperSettings* wrapper,
@@ -140,9 +140,7 @@ void readSettings(const ros::NodeHandle& private_nh, WrapperSettings* wrapper,
     if (!private_nh.getParam(name, value)) continue;
     root[name] = toYaml(value, name);
   }
-  std::ostringstream text;
-  text << root;
-  parseSettings(text.str(), "parameters of " + private_nh.getNamespace(), wrapper, pipeline);
+  parseSettings(root, "parameters of " + private_nh.getNamespace(), wrapper, pipeline);
 }
 
 }  // namespace camera_imu_alignment

@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "bag_topics.h"
+#include "camera_imu_alignment/io/default_frames.h"
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
 #include "camera_imu_alignment/io/calibration_report.h"
 #include "camera_imu_alignment/io/input_error.h"
@@ -100,10 +101,10 @@ class RejectLog {
     const int n = ++shown_[reason];
     if (n <= 3) {
       std::cerr << "[calibrate_bag] " << topicOf(stream) << ": rejected ("
-                << cia::rejectReasonName(reason) << "): " << detail << "\n";
+                << cia::toString(reason) << "): " << detail << "\n";
     }
     if (n == 3) {
-      std::cerr << "[calibrate_bag] (further '" << cia::rejectReasonName(reason)
+      std::cerr << "[calibrate_bag] (further '" << cia::toString(reason)
                 << "' rejections are counted, not shown)\n";
     }
   }
@@ -122,7 +123,7 @@ class RejectLog {
       case cia::InputStream::kCameraPose:
         break;
     }
-    return cia::inputStreamName(stream);
+    return cia::toString(stream);
   }
 
   cia::BagTopics topics_;
@@ -289,8 +290,8 @@ int run(const cia::CliArgs& args) {
   report.rejections = pipeline.rejections();
   report.start_s = info.start_s;
   report.end_s = info.end_s;
-  report.camera_frame = info.camera_frame.empty() ? "camera_optical_frame" : info.camera_frame;
-  report.imu_frame = info.imu_frame.empty() ? "imu_link" : info.imu_frame;
+  report.camera_frame = cia::frameOr(info.camera_frame, cia::kDefaultCameraFrame);
+  report.imu_frame = cia::frameOr(info.imu_frame, cia::kDefaultImuFrame);
   report.source = bag_path;
   report.pairs = pipeline.windowPairs();
   std::cout << cia::formatSummary(report);

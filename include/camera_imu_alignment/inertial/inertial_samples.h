@@ -1,5 +1,5 @@
 // Time-stamped inertial and magnetic samples as the core library takes them (plain structs, no ROS
-// messages), and the per-reason count of samples rejected at the input.
+// messages). Inputs refused on the way in are counted in pipeline/input_rejections.h.
 //
 // Frames and units: every vector is in the IMU frame (REP-145). Gyro in rad/s, accelerometer as
 // specific force in m/s^2 (at rest it points up: about +9.81 along the IMU's up axis), magnetic
@@ -8,10 +8,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <array>
-#include <cstdint>
 #include <optional>
-#include <string>
 
 namespace camera_imu_alignment {
 
@@ -27,45 +24,6 @@ struct ImuSample {
 struct MagneticSample {
   double stamp_s = 0.0;
   Eigen::Vector3d field_t = Eigen::Vector3d::Zero();
-};
-
-/// Why an input sample or frame was rejected. Every rejection is counted, never propagated.
-enum class RejectReason {
-  kNonFinite,       ///< NaN or Inf in a value or the stamp
-  kZeroVector,      ///< accelerometer or magnetometer norm (near) zero
-  kStampBackwards,  ///< stamp earlier than the previous sample of the same stream
-  kDuplicateStamp,  ///< stamp equal to the previous sample of the same stream
-  kMissingStamp,    ///< header stamp zero: the driver never set it (ROS messages only)
-  kMagneticUnits,   ///< field norm far outside 20-70 microtesla (gauss or microtesla sent as T?)
-  kBadImage,        ///< empty image, unsupported encoding, size differs from the camera info
-  kBadCameraInfo,   ///< zero/non-finite K, D of a wrong length, unknown distortion model
-  kTargetNotFound,  ///< no (or too little of the) target detected in a frame at rest
-  kPoseRejected,    ///< PnP failed, reprojection error too high or ambiguous planar solution
-  kCount            ///< number of reasons (not a reason)
-};
-
-/// Which input a rejected item came from; the nodelet names the topic, calibrate_bag the bag topic.
-enum class InputStream { kImu, kMagnetometer, kImage, kCameraInfo, kCameraPose };
-
-/// "imu", "mag", "image", "camera_info", "camera_pose".
-const char* inputStreamName(InputStream stream);
-
-/// Short snake_case name of a reason ("non_finite", "stamp_backwards", ...), for logs and reports.
-const char* rejectReasonName(RejectReason reason);
-
-/// Counts of rejected inputs by reason.
-class RejectionCounts {
- public:
-  void add(RejectReason reason, std::uint64_t n = 1) { counts_[index(reason)] += n; }
-  std::uint64_t count(RejectReason reason) const { return counts_[index(reason)]; }
-  std::uint64_t total() const;
-  /// "non_finite: 3, stamp_backwards: 1" (reasons with a zero count left out), or "none".
-  std::string summary() const;
-  void clear() { counts_.fill(0); }
-
- private:
-  static std::size_t index(RejectReason reason) { return static_cast<std::size_t>(reason); }
-  std::array<std::uint64_t, static_cast<std::size_t>(RejectReason::kCount)> counts_{};
 };
 
 }  // namespace camera_imu_alignment

@@ -7,13 +7,14 @@
 #include <optional>
 #include <string>
 
+#include "camera_imu_alignment/io/default_frames.h"
 #include "camera_imu_alignment/solver/alignment_solver.h"
 
 namespace camera_imu_alignment {
 
 struct ResultMetadata {
-  std::string camera_frame = "camera_optical_frame";  ///< image header frame_id
-  std::string imu_frame = "imu_link";                 ///< Imu header frame_id
+  std::string camera_frame = kDefaultCameraFrame;  ///< image header frame_id
+  std::string imu_frame = kDefaultImuFrame;                 ///< Imu header frame_id
   int num_poses = 0;  ///< stationary poses behind the pairs (0: pairs given)
 };
 

@@ -48,9 +48,11 @@
 #include "camera_imu_alignment/vision/camera_model.h"
 #include "camera_imu_alignment/inertial/imu_attitude.h"
 #include "camera_imu_alignment/inertial/inertial_samples.h"
+#include "camera_imu_alignment/pipeline/input_rejections.h"
 #include "camera_imu_alignment/inertial/magnetometer.h"
 #include "camera_imu_alignment/solver/pose_window.h"
 #include "camera_imu_alignment/inertial/stationary_detector.h"
+#include "camera_imu_alignment/vision/camera_pose.h"
 #include "camera_imu_alignment/vision/target_detector.h"
 
 namespace camera_imu_alignment {
@@ -97,6 +99,16 @@ struct PipelineSettings {
   std::string validate() const;
 };
 
+/// Where a pose's R_world_imu came from (the rule above).
+enum class PoseImuSource {
+  kGyro,       ///< the gyro chain
+  kAccelMag,   ///< accelerometer + magnetometer
+  kAccelOnly,  ///< accelerometer alone (heading 0; a new group)
+  kMessage,    ///< the Imu message's own orientation
+};
+/// "gyro", "accel_mag", "accel_only", "message".
+const char* toString(PoseImuSource source);
+
 /// A stationary pose as the pipeline assembled it.
 struct StationaryPose {
   int index = 0;  ///< 0-based, in order of the recording
@@ -110,7 +122,7 @@ struct StationaryPose {
   double reprojection_rms_px = 0.0;  ///< mean over the frames used
   // IMU.
   Eigen::Matrix3d R_world_imu = Eigen::Matrix3d::Identity();  ///< used for the pairs
-  std::string imu_source;                                     ///< "gyro", "accel_mag", "accel_only"
+  PoseImuSource imu_source = PoseImuSource::kGyro;           ///< where R_world_imu came from
   bool magnetometer_usable = false;
   std::string magnetometer_note;  ///< why not usable ("disturbed: dip changed by 5.1 deg", ...)
   std::optional<Eigen::Matrix3d> R_world_imu_accel_mag;  ///< when the field is usable

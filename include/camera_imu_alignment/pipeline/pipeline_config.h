@@ -7,11 +7,23 @@
 #include <vector>
 
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/pipeline/setting_keys.h"
 
 namespace camera_imu_alignment {
 
-/// Every key this reader knows, in documentation order.
+/// The pipeline's keys, in documentation order.
+const std::vector<SettingKey<PipelineSettings>>& pipelineKeys();
+/// Their names.
 const std::vector<std::string>& pipelineConfigKeys();
+
+/// Reads one key's value into `settings`; throws InputError naming `source` and the key on an
+/// unknown key or a value of the wrong type.
+void readPipelineKey(const std::string& source, const std::string& name, const YAML::Node& value,
+                     PipelineSettings* settings);
+/// Throws InputError naming `source` when the settings are unusable together.
+void checkPipelineSettings(const std::string& source, const PipelineSettings& settings);
+/// YAML text -> a map node (or null for an empty text); throws InputError naming `source`.
+YAML::Node parseSettingsYaml(const std::string& text, const std::string& source);
 
 /// Reads a YAML file of `key: value` pairs over `settings` (absent keys keep their value).
 /// Throws InputError naming the file and key on an unknown key, a wrong type, a value out of

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/pipeline/pipeline_config.h"
 
 namespace camera_imu_alignment {
 
@@ -42,7 +43,10 @@ const std::vector<std::string>& wrapperKeys();
 void readSettings(const ros::NodeHandle& private_nh, WrapperSettings* wrapper,
                   PipelineSettings* pipeline);
 
-/// Same from YAML text (the parameters as a flat map); `source` names it in messages.
+/// Same from a flat YAML map of parameters; `source` names it in messages.
+void parseSettings(const YAML::Node& root, const std::string& source, WrapperSettings* wrapper,
+                   PipelineSettings* pipeline);
+/// Same from YAML text.
 void parseSettings(const std::string& yaml_text, const std::string& source,
                    WrapperSettings* wrapper, PipelineSettings* pipeline);
 

@@ -18,7 +18,7 @@ enum class SolverMethod {
 };
 
 /// "optimal" / "two_step".
-std::string toString(SolverMethod method);
+const char* toString(SolverMethod method);
 /// Parses "optimal" / "two_step"; false on anything else.
 bool parseSolverMethod(const std::string& text, SolverMethod* method);
 
@@ -35,6 +35,9 @@ enum class SolveStatus {
   kPoorFit,   ///< the two-step settled on a fixed point that fits far worse than the closed form
   kBadInput,  ///< no pairs, or a pair that is not a rotation
 };
+
+/// "ok", "not observable", "poor fit", "bad input" (as the summary and the report print it).
+const char* toString(SolveStatus status);
 
 struct AlignmentResult {
   SolveStatus status = SolveStatus::kBadInput;

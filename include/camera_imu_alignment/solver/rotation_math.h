@@ -45,6 +45,10 @@ bool isRotationMatrix(const Eigen::Matrix3d& R, double tolerance = 1e-6);
 /// Random rotation uniformly distributed on SO(3), from three uniform numbers in [0, 1).
 Eigen::Matrix3d uniformRotation(double u1, double u2, double u3);
 
+/// Roll, pitch, yaw (deg) with R = Rz(yaw) Ry(pitch) Rx(roll): the x-y-z fixed-axis convention of
+/// tf and of every output of this package. At pitch +-90 deg roll is reported as 0.
+Eigen::Vector3d rollPitchYawDeg(const Eigen::Matrix3d& R);
+
 /// Degrees <-> radians.
 constexpr double kPi = 3.14159265358979323846;
 constexpr double deg2rad(double deg) { return deg * kPi / 180.0; }

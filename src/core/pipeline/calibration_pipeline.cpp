@@ -24,6 +24,20 @@ const char* toString(ImuOrientationSource source) {
   }
 }
 
+const char* toString(PoseImuSource source) {
+  switch (source) {
+    case PoseImuSource::kGyro:
+      return "gyro";
+    case PoseImuSource::kAccelMag:
+      return "accel_mag";
+    case PoseImuSource::kAccelOnly:
+      return "accel_only";
+    case PoseImuSource::kMessage:
+      return "message";
+  }
+  return "unknown";
+}
+
 bool parseImuOrientationSource(const std::string& text, ImuOrientationSource* source) {
   if (text == "auto") {
     *source = ImuOrientationSource::kAuto;

@@ -5,6 +5,7 @@
 #include <deque>
 #include <limits>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
@@ -72,8 +73,19 @@ struct CalibrationPipeline::Impl {
   /// Processes queued frames whose rest/motion status the IMU has settled.
   void processFrames(bool flush);
   void processFrame(const CameraFrame& frame);
-  /// A stationary segment ended: build the pose (pose_assembly.cpp).
+  /// A stationary segment ended: build the pose (pose_assembly.cpp) in these steps.
   void onSegment(const StationarySegment& segment);
+  /// The rest's mean field: sets magnetometer_usable / R_world_imu_accel_mag or the note why not.
+  void assessMagnetometer(const StationarySegment& segment, StationaryPose* pose);
+  /// The gyro rotation since the previous rest (R_imu_previous_imu_gyro) and its difference to
+  /// the accelerometer + magnetometer one.
+  void integrateGyroSincePrevious(const StationarySegment& segment, StationaryPose* pose) const;
+  /// R_world_imu, imu_source and group by the rule in calibration_pipeline.h; advances the chain.
+  void chooseImuOrientation(const StationarySegment& segment, StationaryPose* pose);
+  /// The camera orientation from the frames inside the rest; the reason the rest is no pose, or "".
+  std::string assessCamera(const StationarySegment& segment, StationaryPose* pose);
+  /// Adds the pose to the history and the window, reports it and solves when enough.
+  void acceptPose(const StationaryPose& pose);
   void solveAndReport();
   AlignmentResult solve() const;
 };

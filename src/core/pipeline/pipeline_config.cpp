@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <functional>
 #include <sstream>
 
 #include "camera_imu_alignment/io/input_error.h"
@@ -13,15 +12,11 @@
 namespace camera_imu_alignment {
 namespace {
 
-/// One configuration key: how to read it into the settings.
-struct Key {
-  std::string name;
-  std::function<void(const YAML::Node&, PipelineSettings*)> read;
-};
+using Key = SettingKey<PipelineSettings>;
 
-template <typename T>
-Key number(const std::string& name, std::function<T*(PipelineSettings*)> field) {
-  return {name, [field](const YAML::Node& node, PipelineSettings* s) { *field(s) = node.as<T>(); }};
+template <typename T, typename Access>
+Key number(const std::string& name, Access access) {
+  return fieldKey<T, PipelineSettings>(name, access);
 }
 
 const std::vector<Key>& keys() {
@@ -102,45 +97,56 @@ const std::vector<Key>& keys() {
 
 }  // namespace
 
+const std::vector<SettingKey<PipelineSettings>>& pipelineKeys() { return keys(); }
+
 const std::vector<std::string>& pipelineConfigKeys() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> n;
-    for (const auto& key : keys()) n.push_back(key.name);
-    return n;
-  }();
+  static const std::vector<std::string> names = keyNames(keys());
   return names;
 }
 
-void parsePipelineConfig(const std::string& text, const std::string& source,
-                         PipelineSettings* settings, const std::vector<std::string>& ignored_keys) {
+void readPipelineKey(const std::string& source, const std::string& name, const YAML::Node& value,
+                     PipelineSettings* settings) {
+  const Key* key = findKey(keys(), name);
+  if (!key) throw InputError(source + ": unknown key '" + name + "' (see config/default.yaml)");
+  try {
+    key->read(value, settings);
+  } catch (const YAML::Exception& e) {
+    throw InputError(source + ": key '" + name + "': " + e.msg);
+  }
+}
+
+void checkPipelineSettings(const std::string& source, const PipelineSettings& settings) {
+  if (settings.solver.two_step.max_iterations < 1) {
+    throw InputError(source + ": key 'two_step_max_iterations' must be >= 1");
+  }
+  const std::string error = settings.validate();
+  if (!error.empty()) throw InputError(source + ": " + error);
+}
+
+YAML::Node parseSettingsYaml(const std::string& text, const std::string& source) {
   YAML::Node root;
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw InputError(source + ": not valid YAML: " + e.what());
   }
+  if (!root.IsNull() && !root.IsMap()) {
+    throw InputError(source + ": expected a map of 'key: value' settings");
+  }
+  return root;
+}
+
+void parsePipelineConfig(const std::string& text, const std::string& source,
+                         PipelineSettings* settings, const std::vector<std::string>& ignored_keys) {
+  const YAML::Node root = parseSettingsYaml(text, source);
   if (root.IsNull()) return;
-  if (!root.IsMap()) throw InputError(source + ": expected a map of 'key: value' settings");
   PipelineSettings updated = *settings;
   for (const auto& entry : root) {
     const std::string name = entry.first.as<std::string>();
     if (std::find(ignored_keys.begin(), ignored_keys.end(), name) != ignored_keys.end()) continue;
-    const auto it =
-        std::find_if(keys().begin(), keys().end(), [&](const Key& k) { return k.name == name; });
-    if (it == keys().end()) {
-      throw InputError(source + ": unknown key '" + name + "' (see config/default.yaml)");
-    }
-    try {
-      it->read(entry.second, &updated);
-    } catch (const YAML::Exception& e) {
-      throw InputError(source + ": key '" + name + "': " + e.msg);
-    }
+    readPipelineKey(source, name, entry.second, &updated);
   }
-  if (updated.solver.two_step.max_iterations < 1) {
-    throw InputError(source + ": key 'two_step_max_iterations' must be >= 1");
-  }
-  const std::string error = updated.validate();
-  if (!error.empty()) throw InputError(source + ": " + error);
+  checkPipelineSettings(source, updated);
   *settings = updated;
 }
 

@@ -119,49 +119,67 @@ void CalibrationPipeline::Impl::onSegment(const StationarySegment& segment) {
   pose.start_s = segment.start_s;
   pose.end_s = segment.end_s;
   pose.gyro_bias_rad_s = segment.gyro_bias_rad_s;
+  assessMagnetometer(segment, &pose);
+  integrateGyroSincePrevious(segment, &pose);
+  chooseImuOrientation(segment, &pose);
+  const std::string rejection = assessCamera(segment, &pose);
+  if (!rejection.empty()) {
+    const RejectedPose rejected_pose{segment.start_s, segment.end_s, rejection};
+    pushBounded(&rejected, rejected_pose);
+    if (callbacks.on_pose_rejected) callbacks.on_pose_rejected(rejected_pose);
+    return;
+  }
+  acceptPose(pose);
+}
 
-  // --- Magnetometer: usable when there are samples, the attitude is defined and it is undisturbed.
+void CalibrationPipeline::Impl::assessMagnetometer(const StationarySegment& segment,
+                                                   StationaryPose* pose) {
+  // Usable when there are samples, the attitude is defined and the field is undisturbed.
   const SegmentField field = segmentField(mag_buffer, segment.start_s, segment.end_s);
   if (field.count < kMinFieldSamples) {
-    pose.magnetometer_note = field.count == 0 && num_mag == 0
-                                 ? "no magnetometer data"
-                                 : "only " + std::to_string(field.count) + " field samples";
+    pose->magnetometer_note = field.count == 0 && num_mag == 0
+                                  ? "no magnetometer data"
+                                  : "only " + std::to_string(field.count) + " field samples";
+    return;
+  }
+  const AttitudeFromVectors attitude =
+      attitudeFromAccelMag(segment.mean_accel_m_s2, field.mean_t, settings.accel_weight);
+  std::string why;
+  if (!attitude.valid) {
+    pose->magnetometer_note = "field parallel to gravity or zero";
+  } else if (disturbance.check(attitude.field_norm_t, attitude.dip_deg, field.scatter_deg, &why)) {
+    pose->magnetometer_note = "disturbed: " + why;
   } else {
-    const AttitudeFromVectors attitude =
-        attitudeFromAccelMag(segment.mean_accel_m_s2, field.mean_t, settings.accel_weight);
-    std::string why;
-    if (!attitude.valid) {
-      pose.magnetometer_note = "field parallel to gravity or zero";
-    } else if (disturbance.check(attitude.field_norm_t, attitude.dip_deg, field.scatter_deg,
-                                 &why)) {
-      pose.magnetometer_note = "disturbed: " + why;
-    } else {
-      pose.magnetometer_usable = true;
-      pose.R_world_imu_accel_mag = attitude.R_world_imu;
-    }
+    pose->magnetometer_usable = true;
+    pose->R_world_imu_accel_mag = attitude.R_world_imu;
   }
+}
 
-  // --- Gyro since the previous segment (bias: mean of the two rests' gyro means).
-  if (chain_valid) {
-    const double t0 = chain_segment.end_s, t1 = segment.start_s;
-    const bool covered = !imu_buffer.empty() && !imu_buffer_truncated &&
-                         imu_buffer.front().stamp_s <= t0 + settings.stationary.max_gap_s &&
-                         t1 - t0 <= settings.max_gyro_span_s;
-    Eigen::Matrix3d R_prev_cur;
-    const Eigen::Vector3d bias = 0.5 * (chain_segment.gyro_bias_rad_s + segment.gyro_bias_rad_s);
-    if (covered && integrateGyro(std::vector<ImuSample>(imu_buffer.begin(), imu_buffer.end()), bias,
-                                 t0, t1, &R_prev_cur, settings.stationary.max_gap_s)) {
-      pose.R_imu_previous_imu_gyro = projectToSO3(R_prev_cur);
-    }
-    if (pose.R_imu_previous_imu_gyro && pose.R_world_imu_accel_mag && chain_R_world_imu_accel_mag) {
-      const Eigen::Matrix3d B_mag =
-          chain_R_world_imu_accel_mag->transpose() * *pose.R_world_imu_accel_mag;
-      pose.gyro_mag_difference_deg =
-          rad2deg(rotationAngle(pose.R_imu_previous_imu_gyro->transpose() * B_mag));
-    }
+void CalibrationPipeline::Impl::integrateGyroSincePrevious(const StationarySegment& segment,
+                                                           StationaryPose* pose) const {
+  // Bias: mean of the two rests' gyro means.
+  if (!chain_valid) return;
+  const double t0 = chain_segment.end_s, t1 = segment.start_s;
+  const bool covered = !imu_buffer.empty() && !imu_buffer_truncated &&
+                       imu_buffer.front().stamp_s <= t0 + settings.stationary.max_gap_s &&
+                       t1 - t0 <= settings.max_gyro_span_s;
+  Eigen::Matrix3d R_prev_cur;
+  const Eigen::Vector3d bias = 0.5 * (chain_segment.gyro_bias_rad_s + segment.gyro_bias_rad_s);
+  if (covered && integrateGyro(std::vector<ImuSample>(imu_buffer.begin(), imu_buffer.end()), bias,
+                               t0, t1, &R_prev_cur, settings.stationary.max_gap_s)) {
+    pose->R_imu_previous_imu_gyro = projectToSO3(R_prev_cur);
   }
+  if (pose->R_imu_previous_imu_gyro && pose->R_world_imu_accel_mag && chain_R_world_imu_accel_mag) {
+    const Eigen::Matrix3d B_mag =
+        chain_R_world_imu_accel_mag->transpose() * *pose->R_world_imu_accel_mag;
+    pose->gyro_mag_difference_deg =
+        rad2deg(rotationAngle(pose->R_imu_previous_imu_gyro->transpose() * B_mag));
+  }
+}
 
-  // --- The orientation used (rule in calibration_pipeline.h).
+void CalibrationPipeline::Impl::chooseImuOrientation(const StationarySegment& segment,
+                                                     StationaryPose* pose) {
+  // The rule in calibration_pipeline.h.
   const bool prefer_mag = settings.imu_orientation == ImuOrientationSource::kMagnetometer;
   const std::optional<Eigen::Matrix3d> R_message =
       settings.imu_orientation == ImuOrientationSource::kMessage
@@ -171,35 +189,38 @@ void CalibrationPipeline::Impl::onSegment(const StationarySegment& segment) {
     if (chain_valid && !group_message) ++group;  // the sensor's frame, unrelated to ours
     group_message = true;
     group_magnetic = false;
-    pose.R_world_imu = *R_message;
-    pose.imu_source = "message";
-  } else if (pose.R_imu_previous_imu_gyro &&
-             !(prefer_mag && pose.magnetometer_usable && group_magnetic)) {
-    pose.R_world_imu = projectToSO3(chain_R_world_imu * *pose.R_imu_previous_imu_gyro);
-    pose.imu_source = "gyro";
-  } else if (pose.magnetometer_usable) {
+    pose->R_world_imu = *R_message;
+    pose->imu_source = PoseImuSource::kMessage;
+  } else if (pose->R_imu_previous_imu_gyro &&
+             !(prefer_mag && pose->magnetometer_usable && group_magnetic)) {
+    pose->R_world_imu = projectToSO3(chain_R_world_imu * *pose->R_imu_previous_imu_gyro);
+    pose->imu_source = PoseImuSource::kGyro;
+  } else if (pose->magnetometer_usable) {
     if (chain_valid && !group_magnetic) ++group;  // the old chain's heading was arbitrary
     group_magnetic = true;
     group_message = false;
-    pose.R_world_imu = *pose.R_world_imu_accel_mag;
-    pose.imu_source = "accel_mag";
+    pose->R_world_imu = *pose->R_world_imu_accel_mag;
+    pose->imu_source = PoseImuSource::kAccelMag;
   } else {
     if (chain_valid) ++group;  // heading unknown relative to everything before
     group_magnetic = false;
     group_message = false;
-    pose.R_world_imu = attitudeFromAccel(segment.mean_accel_m_s2);
-    pose.imu_source = "accel_only";
+    pose->R_world_imu = attitudeFromAccel(segment.mean_accel_m_s2);
+    pose->imu_source = PoseImuSource::kAccelOnly;
   }
-  pose.group = group;
+  pose->group = group;
   chain_valid = true;
   chain_segment = segment;
-  chain_R_world_imu = pose.R_world_imu;
-  chain_R_world_imu_accel_mag = pose.R_world_imu_accel_mag;
+  chain_R_world_imu = pose->R_world_imu;
+  chain_R_world_imu_accel_mag = pose->R_world_imu_accel_mag;
   imu_buffer_truncated = false;
   while (!imu_buffer.empty() && imu_buffer.front().stamp_s < segment.end_s) imu_buffer.pop_front();
   while (!mag_buffer.empty() && mag_buffer.front().stamp_s < segment.end_s) mag_buffer.pop_front();
+}
 
-  // --- Camera: the frames inside the segment, margins off both ends.
+std::string CalibrationPipeline::Impl::assessCamera(const StationarySegment& segment,
+                                                    StationaryPose* pose) {
+  // The frames inside the segment, margins off both ends; later ones are kept for the next rest.
   std::vector<Eigen::Matrix3d> rotations;
   double reprojection_sum = 0.0;
   const double lo = segment.start_s + settings.frame_margin_s;
@@ -208,7 +229,7 @@ void CalibrationPipeline::Impl::onSegment(const StationarySegment& segment) {
     if (d.stamp_s < lo || d.stamp_s > hi) continue;
     rotations.push_back(d.pose.R_target_cam);
     reprojection_sum += d.pose.reprojection_rms_px;
-    pose.p_target_cam = d.pose.p_target_cam;
+    pose->p_target_cam = d.pose.p_target_cam;
   }
   std::vector<FrameDetection> later;
   for (const auto& d : detections) {
@@ -216,38 +237,28 @@ void CalibrationPipeline::Impl::onSegment(const StationarySegment& segment) {
   }
   detections.swap(later);
 
-  RejectedPose rejection{segment.start_s, segment.end_s, ""};
   if (static_cast<int>(rotations.size()) < settings.min_frames_per_pose) {
-    if (!intrinsics) {
-      rejection.reason = "no camera info received yet";
-    } else if (num_frames == 0) {
-      rejection.reason = "no camera data";
-    } else {
-      rejection.reason = "target seen in " + std::to_string(rotations.size()) + " frame(s), " +
-                         std::to_string(settings.min_frames_per_pose) + " needed";
-    }
-  } else {
-    const RotationAverage average =
-        averageRotations(rotations, 4.0 * settings.max_camera_spread_deg);
-    if (average.num_inliers < settings.min_frames_per_pose ||
-        average.spread_rms_deg > settings.max_camera_spread_deg) {
-      rejection.reason = "camera orientation scatter " + fmt(average.spread_rms_deg) +
-                         " deg over " + std::to_string(rotations.size()) + " frames (limit " +
-                         fmt(settings.max_camera_spread_deg) + ")";
-    } else {
-      pose.R_target_cam =
-          resolveSymmetry(average.mean, pose.R_world_imu, pose.group, poses, symmetries);
-      pose.num_frames = average.num_inliers;
-      pose.camera_spread_deg = average.spread_rms_deg;
-      pose.reprojection_rms_px = reprojection_sum / static_cast<double>(rotations.size());
-    }
+    if (!intrinsics) return "no camera info received yet";
+    if (num_frames == 0) return "no camera data";
+    return "target seen in " + std::to_string(rotations.size()) + " frame(s), " +
+           std::to_string(settings.min_frames_per_pose) + " needed";
   }
-  if (!rejection.reason.empty()) {
-    pushBounded(&rejected, rejection);
-    if (callbacks.on_pose_rejected) callbacks.on_pose_rejected(rejection);
-    return;
+  const RotationAverage average = averageRotations(rotations, 4.0 * settings.max_camera_spread_deg);
+  if (average.num_inliers < settings.min_frames_per_pose ||
+      average.spread_rms_deg > settings.max_camera_spread_deg) {
+    return "camera orientation scatter " + fmt(average.spread_rms_deg) + " deg over " +
+           std::to_string(rotations.size()) + " frames (limit " +
+           fmt(settings.max_camera_spread_deg) + ")";
   }
+  pose->R_target_cam = resolveSymmetry(average.mean, pose->R_world_imu, pose->group, poses,
+                                       symmetries);
+  pose->num_frames = average.num_inliers;
+  pose->camera_spread_deg = average.spread_rms_deg;
+  pose->reprojection_rms_px = reprojection_sum / static_cast<double>(rotations.size());
+  return "";
+}
 
+void CalibrationPipeline::Impl::acceptPose(const StationaryPose& pose) {
   pushBounded(&poses, pose);
   ++poses_total;
   PoseOrientation orientation;

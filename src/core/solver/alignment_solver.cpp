@@ -8,8 +8,22 @@
 
 namespace camera_imu_alignment {
 
-std::string toString(SolverMethod method) {
+const char* toString(SolverMethod method) {
   return method == SolverMethod::kTwoStep ? "two_step" : "optimal";
+}
+
+const char* toString(SolveStatus status) {
+  switch (status) {
+    case SolveStatus::kOk:
+      return "ok";
+    case SolveStatus::kNotObservable:
+      return "not observable";
+    case SolveStatus::kPoorFit:
+      return "poor fit";
+    case SolveStatus::kBadInput:
+      return "bad input";
+  }
+  return "unknown";
 }
 
 bool parseSolverMethod(const std::string& text, SolverMethod* method) {
@@ -97,7 +111,7 @@ AlignmentResult solveAlignment(const RotationPairs& pairs, const SolverOptions& 
     std::snprintf(
         msg, sizeof(msg),
         "solved with %s: %d/%d pairs, residual RMS %.3g deg, 1-sigma [%.3g %.3g %.3g] deg%s",
-        toString(options.method).c_str(), result.quality.num_inliers, result.quality.num_pairs,
+        toString(options.method), result.quality.num_inliers, result.quality.num_pairs,
         result.quality.residual_rms_deg, sd.x(), sd.y(), sd.z(),
         result.converged ? "" : " (iteration limit reached before convergence)");
     result.message = msg;

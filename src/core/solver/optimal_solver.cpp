@@ -181,62 +181,70 @@ int refineRotation(const RotationPairs& pairs, const std::vector<int>& indices,
   return refine(pairs, PairQuaternions(pairs), indices, settings, R_cam_imu, converged, residuals);
 }
 
-OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) {
-  OptimalResult result;
-  const int n = static_cast<int>(pairs.size());
-  const auto settings = [&o](double cauchy_scale) {
-    RefineSettings s;
-    s.cauchy_scale_rad = cauchy_scale;
-    s.max_iterations = o.max_iterations;
-    s.step_tolerance_rad = o.step_tolerance_rad;
-    return s;
-  };
-  result.inlier.assign(n, true);
-  result.rejection.assign(n, "");
-  if (n == 0) return result;
+namespace {
 
-  // 1. Angle gate. The angles are kept for the quality diagnostics.
-  std::vector<double> angle_diff(n);
-  result.pair_angles_rad.resize(n);
+RefineSettings refineSettings(const OptimalOptions& o, double cauchy_scale) {
+  RefineSettings s;
+  s.cauchy_scale_rad = cauchy_scale;
+  s.max_iterations = o.max_iterations;
+  s.step_tolerance_rad = o.step_tolerance_rad;
+  return s;
+}
+
+/// Step 1, the angle gate: camera and IMU rotation angles of a pair must agree. Returns the pairs
+/// that pass; fills result.pair_angles_rad (kept for the quality diagnostics), marks the others
+/// as rejected and returns each pair's angle difference in `angle_diff`.
+std::vector<int> angleGate(const RotationPairs& pairs, const OptimalOptions& o,
+                           OptimalResult* result, std::vector<double>* angle_diff) {
+  const int n = static_cast<int>(pairs.size());
+  angle_diff->resize(n);
+  result->pair_angles_rad.resize(n);
   for (int j = 0; j < n; ++j) {
-    Eigen::Vector2d& angles = result.pair_angles_rad[j];
+    Eigen::Vector2d& angles = result->pair_angles_rad[j];
     angles << rotationAngle(pairs[j].A_cam), rotationAngle(pairs[j].B_imu);
-    angle_diff[j] = std::abs(angles.x() - angles.y());
+    (*angle_diff)[j] = std::abs(angles.x() - angles.y());
   }
   std::vector<int> gated;
   gated.reserve(n);
   const double gate =
-      std::max(deg2rad(o.angle_gate_min_deg), o.angle_gate_sigmas * 1.4826 * median(angle_diff));
+      std::max(deg2rad(o.angle_gate_min_deg), o.angle_gate_sigmas * 1.4826 * median(*angle_diff));
   for (int j = 0; j < n; ++j) {
-    if (!o.reject_outliers || angle_diff[j] <= gate) {
+    if (!o.reject_outliers || (*angle_diff)[j] <= gate) {
       gated.push_back(j);
       continue;
     }
-    result.inlier[j] = false;
-    result.rejection[j] = "camera and IMU rotation angles differ by " +
-                          std::to_string(rad2deg(angle_diff[j])) + " deg (gate " +
-                          std::to_string(rad2deg(gate)) + " deg)";
+    result->inlier[j] = false;
+    result->rejection[j] = "camera and IMU rotation angles differ by " +
+                           std::to_string(rad2deg((*angle_diff)[j])) + " deg (gate " +
+                           std::to_string(rad2deg(gate)) + " deg)";
   }
-  if (gated.empty()) return result;
+  return gated;
+}
 
-  // 2. Start: the paper's two-step; the closed form when it did not converge or fits worse.
+/// Step 2, the start: the paper's two-step on the gated pairs; the closed form instead when the
+/// two-step did not converge, its iterates disagree, there are few pairs or it fits clearly worse
+/// than the noise suggests (and the closed form fits better). Sets result->two_step and
+/// result->start; returns the start with its residuals (gated order) in `start_residuals`.
+Eigen::Matrix3d chooseStart(const RotationPairs& pairs, const PairQuaternions& quats,
+                            const std::vector<int>& gated, const std::vector<double>& angle_diff,
+                            const OptimalOptions& o, OptimalResult* result,
+                            std::vector<Eigen::Vector3d>* start_residuals) {
   RotationPairs gated_pairs;
   gated_pairs.reserve(gated.size());
   for (int j : gated) gated_pairs.push_back(pairs[j]);
-  result.two_step = solveTwoStep(gated_pairs, o.two_step);
-  Eigen::Matrix3d X = result.two_step.R_cam_imu_left;
-  result.start = "two_step";
-  std::vector<Eigen::Vector3d> start_residuals;
-  const PairQuaternions quats(pairs);
-  if (result.two_step.valid) evaluateResiduals(quats, gated, X, 0.0, &start_residuals);
-  std::vector<double> start_norms = normsOf(start_residuals, gated.size());
+  result->two_step = solveTwoStep(gated_pairs, o.two_step);
+  Eigen::Matrix3d X = result->two_step.R_cam_imu_left;
+  result->start = "two_step";
+  start_residuals->clear();
+  if (result->two_step.valid) evaluateResiduals(quats, gated, X, 0.0, start_residuals);
+  std::vector<double> start_norms = normsOf(*start_residuals, gated.size());
   const double start_median = median(start_norms);
   std::vector<double> gated_angle_diff;
   gated_angle_diff.reserve(gated.size());
   for (int j : gated) gated_angle_diff.push_back(angle_diff[j]);
   const double noise_proxy = median(gated_angle_diff);
-  if (!result.two_step.converged || gated.size() <= 4 ||
-      result.two_step.left_right_disagreement_rad > deg2rad(2.0) ||
+  if (!result->two_step.converged || gated.size() <= 4 ||
+      result->two_step.left_right_disagreement_rad > deg2rad(2.0) ||
       start_median > 4.0 * noise_proxy + 1e-9) {
     if (auto cf = solveClosedForm(pairs, gated)) {
       std::vector<Eigen::Vector3d> cf_residuals;
@@ -244,103 +252,138 @@ OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) 
       std::vector<double> cf_norms = normsOf(cf_residuals, gated.size());
       if (median(cf_norms) < start_median) {
         X = *cf;
-        start_norms.swap(cf_norms);
-        start_residuals.swap(cf_residuals);
-        result.start = "closed_form";
+        start_residuals->swap(cf_residuals);
+        result->start = "closed_form";
       }
     }
   }
+  return X;
+}
+
+/// Pairs of `gated` whose residual norm (same order) is within the threshold.
+std::vector<int> selectWithin(const std::vector<int>& gated, const std::vector<double>& norms,
+                              double threshold) {
+  std::vector<int> in;
+  in.reserve(gated.size());
+  for (size_t i = 0; i < gated.size(); ++i) {
+    if (norms[i] <= threshold) in.push_back(gated[i]);
+  }
+  return in;
+}
+
+/// RANSAC over two-pair minimal solutions for a larger consensus than `*inliers` at `threshold`;
+/// replaces `*inliers` and `*X` when it finds one. Stops adaptively: enough hypotheses to draw an
+/// all-inlier pair with 99.9% probability at the current inlier ratio w: log(0.001)/log(1 - w^2).
+void ransacConsensus(const RotationPairs& pairs, const PairQuaternions& quats,
+                     const std::vector<int>& gated, double threshold, const OptimalOptions& o,
+                     OptimalResult* result, std::vector<int>* inliers, Eigen::Matrix3d* X) {
+  std::vector<int> samples;
+  for (int j : gated) {
+    if (goodSample(pairs[j])) samples.push_back(j);
+  }
+  if (inliers->size() >= gated.size() || samples.size() < 2) return;
+  result->ransac_used = true;
+  std::mt19937 rng(o.seed);
+  std::uniform_int_distribution<size_t> pick(0, samples.size() - 1);
+  const auto needed = [&]() {
+    const double w = static_cast<double>(inliers->size()) / gated.size();
+    return w >= 1.0 ? 0.0 : std::log(1e-3) / std::log(std::max(1e-12, 1.0 - w * w));
+  };
+  const auto classify = [&](const Eigen::Matrix3d& R) {
+    return selectWithin(gated, residualNorms(quats, gated, R), threshold);
+  };
+  for (int h = 0; h < o.ransac_hypotheses && h < needed(); ++h) {
+    const int i1 = samples[pick(rng)], i2 = samples[pick(rng)];
+    if (i1 == i2) continue;
+    Eigen::Matrix3d X_h;
+    if (!minimalSolution(pairs[i1], pairs[i2], &X_h)) continue;
+    std::vector<int> in_h = classify(X_h);
+    if (in_h.size() > inliers->size()) {
+      bool c = false;
+      result->iterations += refine(pairs, quats, in_h, refineSettings(o, 0.0), &X_h, &c);
+      std::vector<int> in_refined = classify(X_h);
+      if (in_refined.size() > inliers->size()) {
+        *inliers = std::move(in_refined);
+        *X = X_h;
+      }
+    }
+  }
+}
+
+/// Step 4: the result's residuals for every pair and the rejection reasons of the gated pairs
+/// that are not inliers.
+void recordResiduals(const RotationPairs& pairs, const std::vector<int>& gated,
+                     const std::vector<int>& inliers,
+                     const std::vector<Eigen::Vector3d>& inlier_residuals, OptimalResult* result) {
+  const int n = static_cast<int>(pairs.size());
+  const Eigen::Matrix3d& X = result->R_cam_imu;
+  result->residuals.assign(n, Eigen::Vector3d::Zero());
+  for (size_t i = 0; i < inliers.size(); ++i) result->residuals[inliers[i]] = inlier_residuals[i];
+  std::vector<bool> is_inlier(n, false);
+  for (int j : inliers) is_inlier[j] = true;
+  for (int j = 0; j < n; ++j) {
+    if (!result->inlier[j]) result->residuals[j] = pairResidual(pairs[j], X);
+  }
+  for (int j : gated) {
+    if (!is_inlier[j]) {
+      result->inlier[j] = false;
+      result->residuals[j] = pairResidual(pairs[j], X);
+      result->rejection[j] = "inconsistent with the consensus: residual " +
+                             std::to_string(rad2deg(result->residuals[j].norm())) + " deg";
+    }
+  }
+}
+
+}  // namespace
+
+OptimalResult solveOptimal(const RotationPairs& pairs, const OptimalOptions& o) {
+  OptimalResult result;
+  const int n = static_cast<int>(pairs.size());
+  result.inlier.assign(n, true);
+  result.rejection.assign(n, "");
+  if (n == 0) return result;
+
+  std::vector<double> angle_diff;
+  const std::vector<int> gated = angleGate(pairs, o, &result, &angle_diff);
+  if (gated.empty()) return result;
+
+  const PairQuaternions quats(pairs);
+  std::vector<Eigen::Vector3d> residuals;
+  Eigen::Matrix3d X = chooseStart(pairs, quats, gated, angle_diff, o, &result, &residuals);
   if (!X.allFinite()) return result;
   const Eigen::Matrix3d X_start = X;
 
   // 3. Least squares on the gated pairs, then the consensus test at that fit (testing at the start
   //    would flag good pairs: the two-step's bias inflates some residuals).
-  std::vector<Eigen::Vector3d> residuals = start_residuals;
   bool converged = false;
-  result.iterations += refine(pairs, quats, gated, settings(0.0), &X, &converged, &residuals);
+  result.iterations +=
+      refine(pairs, quats, gated, refineSettings(o, 0.0), &X, &converged, &residuals);
   std::vector<int> inliers = gated;
   if (o.reject_outliers && gated.size() > 2) {
-    // Pairs of `gated` whose residual norm (same order) is within the threshold.
-    const auto select = [&gated](const std::vector<double>& norms, double threshold) {
-      std::vector<int> in;
-      in.reserve(gated.size());
-      for (size_t i = 0; i < gated.size(); ++i) {
-        if (norms[i] <= threshold) in.push_back(gated[i]);
-      }
-      return in;
-    };
-    const auto classify = [&](const Eigen::Matrix3d& R, double threshold) {
-      return select(residualNorms(quats, gated, R), threshold);
-    };
-    const std::vector<double> norms = normsOf(residuals, gated.size());
-    double threshold = inlierThreshold(norms, o);
-    inliers = select(norms, threshold);
+    double threshold = inlierThreshold(normsOf(residuals, gated.size()), o);
+    inliers = selectWithin(gated, normsOf(residuals, gated.size()), threshold);
     if (inliers.size() < gated.size()) {
       // Suspected outliers: the least-squares fit may have been dragged by them. Robust (Cauchy)
-      // refit from the start, then RANSAC over two-pair minimal solutions for a larger consensus.
+      // refit from the start, then RANSAC for a larger consensus.
       X = X_start;
       bool conv = false;
       const double scale = std::max(deg2rad(o.inlier_min_deg), threshold / o.inlier_sigmas);
-      result.iterations += refine(pairs, quats, gated, settings(scale), &X, &conv);
+      result.iterations += refine(pairs, quats, gated, refineSettings(o, scale), &X, &conv);
       const std::vector<double> robust_norms = residualNorms(quats, gated, X);
       threshold = inlierThreshold(robust_norms, o);
-      inliers = select(robust_norms, threshold);
-      std::vector<int> samples;
-      for (int j : gated) {
-        if (goodSample(pairs[j])) samples.push_back(j);
-      }
-      if (inliers.size() < gated.size() && samples.size() >= 2) {
-        result.ransac_used = true;
-        std::mt19937 rng(o.seed);
-        std::uniform_int_distribution<size_t> pick(0, samples.size() - 1);
-        // Adaptive stop: enough hypotheses to draw an all-inlier pair with 99.9% probability at the
-        // current inlier ratio w: log(0.001) / log(1 - w^2).
-        const auto needed = [&]() {
-          const double w = static_cast<double>(inliers.size()) / gated.size();
-          return w >= 1.0 ? 0.0 : std::log(1e-3) / std::log(std::max(1e-12, 1.0 - w * w));
-        };
-        for (int h = 0; h < o.ransac_hypotheses && h < needed(); ++h) {
-          const int i1 = samples[pick(rng)], i2 = samples[pick(rng)];
-          if (i1 == i2) continue;
-          Eigen::Matrix3d X_h;
-          if (!minimalSolution(pairs[i1], pairs[i2], &X_h)) continue;
-          std::vector<int> in_h = classify(X_h, threshold);
-          if (in_h.size() > inliers.size()) {
-            bool c = false;
-            result.iterations += refine(pairs, quats, in_h, settings(0.0), &X_h, &c);
-            std::vector<int> in_refined = classify(X_h, threshold);
-            if (in_refined.size() > inliers.size()) {
-              inliers = std::move(in_refined);
-              X = X_h;
-            }
-          }
-        }
-      }
+      inliers = selectWithin(gated, robust_norms, threshold);
+      ransacConsensus(pairs, quats, gated, threshold, o, &result, &inliers, &X);
       if (inliers.size() < 2) inliers = gated;  // never fit fewer pairs than the minimum
       // 4. Final least squares on the inliers.
       residuals.clear();
-      result.iterations += refine(pairs, quats, inliers, settings(0.0), &X, &converged, &residuals);
+      result.iterations +=
+          refine(pairs, quats, inliers, refineSettings(o, 0.0), &X, &converged, &residuals);
     }
   }
   result.converged = converged;
   result.R_cam_imu = X;
   result.valid = X.allFinite();
-  result.residuals.assign(n, Eigen::Vector3d::Zero());
-  for (size_t i = 0; i < inliers.size(); ++i) result.residuals[inliers[i]] = residuals[i];
-
-  std::vector<bool> is_inlier(n, false);
-  for (int j : inliers) is_inlier[j] = true;
-  for (int j = 0; j < n; ++j) {
-    if (!result.inlier[j]) result.residuals[j] = pairResidual(pairs[j], X);
-  }
-  for (int j : gated) {
-    if (!is_inlier[j]) {
-      result.inlier[j] = false;
-      result.residuals[j] = pairResidual(pairs[j], X);
-      result.rejection[j] = "inconsistent with the consensus: residual " +
-                            std::to_string(rad2deg(result.residuals[j].norm())) + " deg";
-    }
-  }
+  recordResiduals(pairs, gated, inliers, residuals, &result);
   return result;
 }
 

@@ -178,4 +178,19 @@ Eigen::Matrix3d uniformRotation(double u1, double u2, double u3) {
   return q.normalized().toRotationMatrix();
 }
 
+Eigen::Vector3d rollPitchYawDeg(const Eigen::Matrix3d& R) {
+  // R = Rz(yaw) Ry(pitch) Rx(roll): R(2,0) = -sin(pitch), R(1,0)/R(0,0) = tan(yaw),
+  // R(2,1)/R(2,2) = tan(roll).
+  const double cos_pitch = std::hypot(R(0, 0), R(1, 0));
+  const double pitch = std::atan2(-R(2, 0), cos_pitch);
+  double roll = 0.0, yaw = 0.0;
+  if (cos_pitch > 1e-9) {
+    roll = std::atan2(R(2, 1), R(2, 2));
+    yaw = std::atan2(R(1, 0), R(0, 0));
+  } else {  // gimbal lock (pitch = +-90 deg): only yaw -+ roll is defined; report roll = 0
+    yaw = std::atan2(-R(0, 1), R(1, 1));
+  }
+  return Eigen::Vector3d(rad2deg(roll), rad2deg(pitch), rad2deg(yaw));
+}
+
 }  // namespace camera_imu_alignment

@@ -1,10 +1,12 @@
+#include "camera_imu_alignment/vision/camera_pose.h"
+
 // Camera pose from a planar target: IPPE's two solutions, Levenberg-Marquardt refinement,
 // reprojection and ambiguity checks.
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <sstream>
 
-#include "camera_imu_alignment/vision/target_detector.h"
+
 
 namespace camera_imu_alignment {
 

@@ -1,11 +1,11 @@
 // Rejection reasons and their counts.
-#include "camera_imu_alignment/inertial/inertial_samples.h"
+#include "camera_imu_alignment/pipeline/input_rejections.h"
 
 #include <sstream>
 
 namespace camera_imu_alignment {
 
-const char* rejectReasonName(RejectReason reason) {
+const char* toString(RejectReason reason) {
   switch (reason) {
     case RejectReason::kNonFinite:
       return "non_finite";
@@ -33,7 +33,7 @@ const char* rejectReasonName(RejectReason reason) {
   return "unknown";
 }
 
-const char* inputStreamName(InputStream stream) {
+const char* toString(InputStream stream) {
   switch (stream) {
     case InputStream::kImu:
       return "imu";
@@ -61,7 +61,7 @@ std::string RejectionCounts::summary() const {
   for (std::size_t i = 0; i < counts_.size(); ++i) {
     if (counts_[i] == 0) continue;
     if (!first) out << ", ";
-    out << rejectReasonName(static_cast<RejectReason>(i)) << ": " << counts_[i];
+    out << toString(static_cast<RejectReason>(i)) << ": " << counts_[i];
     first = false;
   }
   return first ? "none" : out.str();

@@ -1,0 +1,42 @@
+// The camera's pose relative to the target from one observation of it: planar PnP with its
+// ambiguity test and reprojection check.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+
+#include "camera_imu_alignment/vision/camera_model.h"
+#include "camera_imu_alignment/vision/target_description.h"
+#include "camera_imu_alignment/vision/target_detector.h"
+
+namespace camera_imu_alignment {
+
+struct PoseSettings {
+  double max_reprojection_rms_px = 1.0;  ///< poses above are rejected
+  /// Planar PnP has two solutions (IPPE); the pose is rejected as ambiguous when the second one's
+  /// reprojection RMS is within this factor of the first (they explain the image equally well).
+  double min_ambiguity_ratio = 1.5;
+};
+
+/// Camera pose relative to the target (CONVENTIONS: R_target_cam; p_target = R_target_cam p_cam +
+/// p_target_cam).
+struct CameraPose {
+  Eigen::Matrix3d R_target_cam = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d p_target_cam =
+      Eigen::Vector3d::Zero();  ///< camera centre in the target frame (m)
+  double reprojection_rms_px = 0.0;
+  double reprojection_mean_px = 0.0;  ///< mean reprojection distance (px)
+  double ambiguity_ratio = 0.0;  ///< second-best / best reprojection RMS of the planar solutions
+  int num_points = 0;
+};
+
+/// PnP (IPPE on undistorted points, then Levenberg-Marquardt refinement). Returns nullopt with the
+/// reason in `why` when there are too few points, PnP fails, the reprojection RMS is above the
+/// limit or the solution is ambiguous.
+std::optional<CameraPose> estimateCameraPose(const TargetObservation& observation,
+                                             const TargetDescription& target,
+                                             const CameraIntrinsics& intrinsics,
+                                             const PoseSettings& settings, std::string* why);
+
+}  // namespace camera_imu_alignment

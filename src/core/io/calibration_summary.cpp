@@ -1,0 +1,147 @@
+// The stdout summary of a calibration run with blocks for Kalibr, OpenVINS, VINS-Mono/Fusion and
+// tf2.
+#include "camera_imu_alignment/io/calibration_summary.h"
+#include "camera_imu_alignment/io/default_frames.h"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <sstream>
+
+#include "camera_imu_alignment/solver/rotation_math.h"
+#include "report_text.h"
+
+namespace camera_imu_alignment {
+namespace {
+
+using report_text::canonicalQuaternion;
+using report_text::exact;
+using report_text::fixed;
+using report_text::fixedList;
+using report_text::hasAxisAdvice;
+
+/// The four rows of the 4x4 transform [R 0; 0 1] as YAML flow sequences, one per line. A template
+/// so that R may be a transpose expression (no temporary).
+template <typename Derived>
+std::string transformRows(const Eigen::MatrixBase<Derived>& R, const std::string& indent) {
+  std::string rows;
+  for (int i = 0; i < 3; ++i) {
+    rows += indent + "- [" + exact(R(i, 0)) + ", " + exact(R(i, 1)) + ", " + exact(R(i, 2)) +
+            ", 0.0]\n";
+  }
+  return rows + indent + "- [0.0, 0.0, 0.0, 1.0]\n";
+}
+
+std::string kalibrBlock(const Eigen::Matrix3d& R_cam_imu) {
+  return "# Kalibr camchain-imucam.yaml: T_cam_imu maps IMU-frame points into the camera frame\n"
+         "# (p_cam = T_cam_imu * p_imu); rotation only: translation not estimated (0 here).\n"
+         "cam0:\n"
+         "  T_cam_imu:\n" +
+         transformRows(R_cam_imu, "  ");
+}
+
+std::string openVinsBlock(const Eigen::Matrix3d& R_cam_imu) {
+  return "# OpenVINS kalibr_imucam_chain.yaml: T_imu_cam = T_cam_imu^-1, R_imu_cam = R_cam_imu^T\n"
+         "# (p_imu = T_imu_cam * p_cam); rotation only, keep your measured translation.\n"
+         "cam0:\n"
+         "  T_imu_cam:\n" +
+         transformRows(R_cam_imu.transpose(), "    ");
+}
+
+std::string vinsBlock(const Eigen::Matrix3d& R_cam_imu) {
+  std::string data;  // R_imu_cam row by row: R_imu_cam(i, k) = R_cam_imu(k, i)
+  for (int i = 0; i < 3; ++i) {
+    data += (i == 0 ? "   data: [" : ",\n          ");
+    data += exact(R_cam_imu(0, i)) + ", " + exact(R_cam_imu(1, i)) + ", " + exact(R_cam_imu(2, i));
+  }
+  return "# VINS-Mono / VINS-Fusion config: extrinsicRotation = R_imu_cam (camera to body/IMU,\n"
+         "# p_imu = R * p_cam, row-major); VINS-Fusion's body_T_cam0 has the same rotation.\n"
+         "extrinsicRotation: !!opencv-matrix\n"
+         "   rows: 3\n"
+         "   cols: 3\n"
+         "   dt: d\n" +
+         data + "]\n";
+}
+
+std::string tfBlock(const Eigen::Matrix3d& R_cam_imu, const std::string& camera_frame,
+                    const std::string& imu_frame) {
+  const Eigen::Quaterniond q = canonicalQuaternion(R_cam_imu);
+  return "# tf2: parent = camera frame, child = IMU frame (maps IMU-frame points into the camera "
+         "frame):\n"
+         "rosrun tf2_ros static_transform_publisher 0 0 0 " +
+         exact(q.x()) + " " + exact(q.y()) + " " + exact(q.z()) + " " + exact(q.w()) + " " +
+         frameOr(camera_frame, kDefaultCameraFrame) + " " + frameOr(imu_frame, kDefaultImuFrame) +
+         "\n";
+}
+
+// --- Summary sections
+
+void writeEstimate(std::ostream& out, const ReportInput& in) {
+  const Eigen::Matrix3d& R = in.result.R_cam_imu;
+  const Eigen::Quaterniond q = canonicalQuaternion(R);
+  out << "R_cam_imu (p_cam = R_cam_imu * p_imu; camera '" << in.camera_frame << "', IMU '"
+      << in.imu_frame << "'):\n";
+  out << "  quaternion xyzw: [" << fixed(q.x(), 9) << ", " << fixed(q.y(), 9) << ", "
+      << fixed(q.z(), 9) << ", " << fixed(q.w(), 9) << "]\n";
+  out << "  matrix:\n";
+  for (int i = 0; i < 3; ++i) out << "    " << fixedList(R.row(i).transpose(), 9) << "\n";
+  out << "  roll, pitch, yaw (deg, R = Rz(yaw) Ry(pitch) Rx(roll)): "
+      << fixedList(rollPitchYawDeg(R), 4) << "\n";
+}
+
+
+void writeQuality(std::ostream& out, const ReportInput& in) {
+  const SolutionQuality& q = in.result.quality;
+  out << "1-sigma about camera x, y, z (deg): " << fixedList(q.std_dev_deg, 4) << "\n";
+  out << "residual RMS (deg): " << fixed(q.residual_rms_deg, 4) << " over " << q.num_inliers
+      << " inlier(s) of " << q.num_pairs << " pair(s)\n";
+  out << "observable: " << (q.observable ? "yes" : "NO") << " (observability "
+      << fixed(q.observability, 3) << ", 0 = one rotation axis .. 1 = all axes evenly)\n";
+  if (hasAxisAdvice(in.result)) {
+    out << "  rotate the rig about the camera " << axisName(q.excite_axis_cam)
+        << " axis to constrain the rotation about camera " << axisName(q.weak_axis_cam) << "\n";
+  }
+  if (!q.observable && !q.observability_message.empty()) {
+    out << "  (" << q.observability_message << ")\n";
+  }
+  out << "solver: " << toString(in.result.method) << ", " << in.result.iterations
+      << " iteration(s), " << (in.result.converged ? "converged" : "not converged") << "\n";
+}
+
+void writePoses(std::ostream& out, const ReportInput& in) {
+  out << "poses used: " << in.poses.size() << ", rests rejected: " << in.rejected.size()
+      << ", IMU rests: " << in.segments.size() << "\n";
+  for (const RejectedPose& r : in.rejected) {
+    out << "  rejected rest " << fixed(r.start_s - in.start_s, 2) << "-"
+        << fixed(r.end_s - in.start_s, 2)
+        << " s (from start): " << (r.reason.empty() ? "(no reason given)" : r.reason) << "\n";
+  }
+  out << "inputs rejected: " << in.rejections.summary() << "\n";
+}
+
+}  // namespace
+
+std::string exportBlocks(const Eigen::Matrix3d& R_cam_imu, const std::string& camera_frame,
+                         const std::string& imu_frame) {
+  return kalibrBlock(R_cam_imu) + "\n" + openVinsBlock(R_cam_imu) + "\n" + vinsBlock(R_cam_imu) +
+         "\n" + tfBlock(R_cam_imu, camera_frame, imu_frame);
+}
+
+std::string formatSummary(const ReportInput& input) {
+  std::ostringstream out;
+  out << "=== camera-IMU rotation"
+      << (input.source.empty() ? std::string() : " (" + input.source + ")") << " ===\n";
+  out << "status: " << toString(input.result.status) << "\n";
+  if (!input.result.message.empty()) out << "message: " << input.result.message << "\n";
+  writeEstimate(out, input);
+  writeQuality(out, input);
+  writePoses(out, input);
+  out << "\n";
+  if (input.result.status != SolveStatus::kOk) {
+    out << "# WARNING: status '" << toString(input.result.status)
+        << "': the blocks below hold the best guess only, do not use them as a calibration.\n";
+  }
+  out << exportBlocks(input.result.R_cam_imu, input.camera_frame, input.imu_frame);
+  return out.str();
+}
+
+}  // namespace camera_imu_alignment
