@@ -47,11 +47,16 @@ std::string temp(const std::string& name) { return ::testing::TempDir() + "cia_s
 TEST(SimulateBag, HelpListsEveryScenario) {
   const RunResult r = run(kSim + " --help");
   EXPECT_EQ(r.exit_code, 0);
-  for (const char* s : {"nominal", "aprilgrid", "circlegrid", "noisy_imu", "few_poses",
-                        "degenerate", "no_magnetometer", "magnetic_disturbance", "time_offset",
-                        "remount", "bad_input", "long_run"}) {
+  for (const char* s :
+       {"nominal", "aprilgrid", "circlegrid", "noisy_imu", "few_poses", "degenerate",
+        "no_magnetometer", "magnetic_disturbance", "time_offset", "remount", "bad_input",
+        "long_run", "tactical", "consumer", "noisy_consumer"}) {
     EXPECT_NE(r.out.find(s), std::string::npos) << s;
   }
+  for (const char* grade : {"ideal:", "tactical:", "consumer:", "noisy:"}) {
+    EXPECT_NE(r.out.find(grade), std::string::npos) << grade;
+  }
+  EXPECT_NE(r.out.find("--imu-grade"), std::string::npos);
 }
 
 TEST(SimulateBag, BadUsageExitsTwoNamingTheOption) {
@@ -61,6 +66,11 @@ TEST(SimulateBag, BadUsageExitsTwoNamingTheOption) {
   r = run(kSim + " --out " + temp("x.bag") + " --scenario nope");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--scenario"), std::string::npos) << r.err;
+  std::remove(temp("x.truth.yaml").c_str());
+  r = run(kSim + " --out " + temp("x.bag") + " --imu-grade military");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--imu-grade"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::ifstream(temp("x.truth.yaml")).good()) << "nothing written";
   r = run(kSim + " --seed 3");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--out"), std::string::npos) << r.err;
@@ -145,6 +155,32 @@ TEST(SimulateBag, ScenariosChangeTopicsAndTruth) {
   ASSERT_EQ(run(kSim + " --out " + offset + " --scenario time_offset" + kShort).exit_code, 0);
   const YAML::Node to = YAML::LoadFile(temp("offset.truth.yaml"));
   EXPECT_DOUBLE_EQ(to["camera"]["time_offset_s"].as<double>(), 0.05);
+}
+
+TEST(SimulateBag, ImuGradeOverridesTheScenariosGradeAndNoiseOptionsOverrideTheGrade) {
+  const std::string fast = kShort + " --camera-rate-hz 1";
+  ASSERT_EQ(run(kSim + " --out " + temp("consumer.bag") + " --scenario consumer" + fast).exit_code,
+            0);
+  YAML::Node t = YAML::LoadFile(temp("consumer.truth.yaml"));
+  EXPECT_EQ(t["imu_errors"]["grade"].as<std::string>(), "consumer");
+  EXPECT_NE(t["imu_errors"]["T_g"][0][0].as<double>(), 1.0);
+
+  const RunResult r = run(kSim + " --out " + temp("override.bag") +
+                          " --scenario noisy_consumer --imu-grade tactical" + fast);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  t = YAML::LoadFile(temp("override.truth.yaml"));
+  EXPECT_EQ(t["scenario"].as<std::string>(), "noisy_consumer");
+  EXPECT_EQ(t["imu_errors"]["grade"].as<std::string>(), "tactical");
+  EXPECT_NEAR(t["imu_errors"]["gyro_noise_density_rad_s_sqrt_hz"].as<double>(), 2.618e-5, 1e-8);
+
+  ASSERT_EQ(run(kSim + " --out " + temp("graded.bag") +
+                " --imu-grade noisy --gyro-noise-density 1e-3" + fast)
+                .exit_code,
+            0);
+  t = YAML::LoadFile(temp("graded.truth.yaml"));
+  EXPECT_EQ(t["imu_errors"]["grade"].as<std::string>(), "noisy");
+  EXPECT_DOUBLE_EQ(t["imu_errors"]["gyro_noise_density_rad_s_sqrt_hz"].as<double>(), 1e-3);
+  EXPECT_DOUBLE_EQ(t["imu_errors"]["sigmas"]["gyro_scale"].as<double>(), 0.03);
 }
 
 TEST(SimulateBag, PlaysWithRosbagPlay) {

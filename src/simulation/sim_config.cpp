@@ -24,6 +24,12 @@ const std::vector<std::pair<std::string, std::string>>& scenarioList() {
        "NaN IMU/magnetometer samples, duplicate and out-of-order stamps, empty and "
        "wrong-encoding images, a zero-K CameraInfo"},
       {"long_run", "40 poses (about 4 minutes), camera at 1.5 Hz"},
+      {"tactical", "nominal with a tactical-grade IMU (ADIS16495 class; --imu-grade tactical)"},
+      {"consumer",
+       "nominal with a consumer IMU (ICM-20948 class): scale, cross-axis, biases, hard/soft "
+       "iron"},
+      {"noisy_consumer",
+       "nominal with the noisy grade: MPU-6050/9250 on a vibrating mount, gyro bias 3 deg/s"},
   };
   return list;
 }
@@ -67,6 +73,12 @@ bool applyScenario(const std::string& name, SimulationConfig* config) {
   } else if (name == "long_run") {
     c.num_poses = 40;
     c.camera_rate_hz = 1.5;
+  } else if (name == "tactical") {
+    applyImuGrade(ImuGrade::kTactical, &c);
+  } else if (name == "consumer") {
+    applyImuGrade(ImuGrade::kConsumer, &c);
+  } else if (name == "noisy_consumer") {
+    applyImuGrade(ImuGrade::kNoisy, &c);
   } else {
     return false;
   }
@@ -118,6 +130,21 @@ std::string validateConfig(const SimulationConfig& c) {
     e << "remount rotation must be finite and at most 180 deg; ";
   if (!std::isfinite(c.remount_time_s)) e << "remount_time_s must be finite; ";
   if (!inRange(c.start_time_s, 1.0, 4e9)) e << "start_time_s must be in [1, 4e9]; ";
+  const SensorNoise& n = c.imu_noise;
+  bool noise_ok = inRange(n.magnetometer_noise_sigma, 0, 1e-4);
+  for (double v : {n.accelerometer_noise_density, n.accelerometer_random_walk,
+                   n.gyroscope_noise_density, n.gyroscope_random_walk,
+                   n.gyroscope_initial_bias_sigma, n.accelerometer_initial_bias_sigma}) {
+    noise_ok = noise_ok && inRange(v, 0, 10);
+  }
+  if (!noise_ok) e << "IMU noise terms must be in [0, 10] (magnetometer: [0, 100] uT); ";
+  const ImuSystematicSigmas& sys = c.imu_systematic;
+  bool sigmas_ok = inRange(sys.mag_hard_iron_sigma, 0, 1e-3);
+  for (double v : {sys.gyro_scale_sigma, sys.gyro_cross_axis_sigma, sys.accel_scale_sigma,
+                   sys.accel_cross_axis_sigma, sys.mag_soft_iron_sigma}) {
+    sigmas_ok = sigmas_ok && inRange(v, 0, 0.2);
+  }
+  if (!sigmas_ok) e << "IMU systematic sigmas must be in [0, 0.2] (hard iron: [0, 1000] uT); ";
   if (!c.earth_field_world.allFinite() || !c.mag_hard_iron.allFinite() ||
       !c.gravity_world.allFinite())
     e << "fields must be finite; ";

@@ -8,8 +8,8 @@
 #include <set>
 #include <sstream>
 
-#include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/simulation/target.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {
 namespace simulation {
@@ -84,6 +84,42 @@ class Writer {
   std::ostringstream o_;
 };
 
+/// The `imu_errors:` block, 17 significant digits (reads back exactly).
+void imuErrorsYaml(const ImuErrors& e, const ImuSystematicSigmas& sigmas, Writer* w) {
+  auto& o = w->o();
+  const SensorNoise& n = e.noise;
+  o << std::setprecision(17)
+    << "imu_errors:  # drawn once per seed; gyro = T_g w + b_g(t) + n_g, accel = T_a f + b_a(t) + "
+       "n_a,\n"
+       "            # mag = S (R_world_imu^T B) + h + n_m (IMU frame = the accelerometer's)\n"
+    << "  grade: " << imuGradeName(e.grade) << "\n  T_g: ";
+  w->matrix(e.T_g);
+  o << "  # gyro scale (diagonal) and cross-axis/misalignment\n  T_a: ";
+  w->matrix(e.T_a);
+  o << "  # accel scale (diagonal) and non-orthogonality (below it)\n  gyro_bias_initial_rad_s: ";
+  w->vec(e.gyro_bias_initial);
+  o << "\n  gyro_bias_walk_rad_s2_sqrt_hz: " << n.gyroscope_random_walk
+    << "\n  accel_bias_initial_m_s2: ";
+  w->vec(e.accel_bias_initial);
+  o << "\n  accel_bias_walk_m_s3_sqrt_hz: " << n.accelerometer_random_walk
+    << "\n  mag_hard_iron_t: ";
+  w->vec(e.mag_hard_iron);
+  o << "  # h\n  mag_soft_iron: ";
+  w->matrix(e.mag_soft_iron);
+  o << "  # S, symmetric\n  gyro_noise_density_rad_s_sqrt_hz: " << n.gyroscope_noise_density
+    << "\n  accel_noise_density_m_s2_sqrt_hz: " << n.accelerometer_noise_density
+    << "\n  mag_noise_sigma_t: " << n.magnetometer_noise_sigma << std::setprecision(12)
+    << "\n  sigmas:  # the grade's 1-sigma spread of the drawn errors"
+    << "\n    gyro_scale: " << sigmas.gyro_scale_sigma
+    << "\n    gyro_cross_axis: " << sigmas.gyro_cross_axis_sigma
+    << "\n    accel_scale: " << sigmas.accel_scale_sigma
+    << "\n    accel_cross_axis: " << sigmas.accel_cross_axis_sigma
+    << "\n    gyro_bias_initial_rad_s: " << n.gyroscope_initial_bias_sigma
+    << "\n    accel_bias_initial_m_s2: " << n.accelerometer_initial_bias_sigma
+    << "\n    mag_hard_iron_t: " << sigmas.mag_hard_iron_sigma
+    << "\n    mag_soft_iron: " << sigmas.mag_soft_iron_sigma << "\n";
+}
+
 }  // namespace
 
 SimulationRun::SimulationRun(const SimulationConfig& c)
@@ -91,7 +127,8 @@ SimulationRun::SimulationRun(const SimulationConfig& c)
       trajectory(c),
       imu(simulateInertial(c, trajectory)),
       mag(simulateMagnetometer(c, trajectory)),
-      disturbances(magneticDisturbances(c, trajectory)) {
+      disturbances(magneticDisturbances(c, trajectory)),
+      imu_errors(drawImuErrors(c)) {
   const long frames = static_cast<long>(std::floor(trajectory.duration() * c.camera_rate_hz)) + 1;
   for (long j = 0; j < frames; ++j) frame_times.push_back(j / c.camera_rate_hz);
   if (c.bad_input) {
@@ -196,8 +233,9 @@ std::string truthYaml(const SimulationRun& run) {
     << "\n  earth_field_world_t: ";
   w.vec(c.earth_field_world);
   o << "\n  hard_iron_t: ";
-  w.vec(c.mag_hard_iron);
-  o << "  # IMU frame\n  disturbances:  # extra world field during [start_s, end_s]\n";
+  w.vec(run.imu_errors.mag_hard_iron);
+  o << "  # IMU frame, option and drawn parts (imu_errors)\n  disturbances:  # extra world field "
+       "during [start_s, end_s]\n";
   for (const MagDisturbance& d : run.disturbances) {
     o << std::setprecision(16) << "    - interval: [" << t0 + d.start_s << ", " << t0 + d.end_s
       << "]\n"
@@ -205,6 +243,7 @@ std::string truthYaml(const SimulationRun& run) {
     w.vec(d.field_world);
     o << "\n";
   }
+  imuErrorsYaml(run.imu_errors, c.imu_systematic, &w);
   o << "topics:\n  imu: " << c.imu_topic << "\n  magnetometer: " << c.mag_topic
     << "\n  image: " << c.image_topic << "\n  camera_info: " << c.camera_info_topic << "\n";
   o << "counts:\n  imu: " << run.imu.size() << "\n  magnetometer: " << run.mag.size()

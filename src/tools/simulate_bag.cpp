@@ -19,10 +19,10 @@
 #include <limits>
 #include <sstream>
 
-#include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/simulation/renderer.h"
 #include "camera_imu_alignment/simulation/simulation_run.h"
 #include "camera_imu_alignment/simulation/target.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 #include "cli_args.h"
 
 namespace cia = camera_imu_alignment;
@@ -33,6 +33,7 @@ namespace {
 const std::set<std::string> kValueOptions = {"--out",
                                              "--seed",
                                              "--scenario",
+                                             "--imu-grade",
                                              "--num-poses",
                                              "--hold-min-s",
                                              "--hold-max-s",
@@ -95,6 +96,8 @@ std::string usage() {
        "  (R_cam_imu, stationary intervals, true poses, noise) and FILE.target.yaml (Kalibr).\n"
        "Scenarios (presets; options below override them):\n";
   for (const auto& s : sim::scenarioList()) o << "  " << s.first << ": " << s.second << "\n";
+  o << "IMU grades (--imu-grade NAME; after the scenario, before the noise options below):\n";
+  for (const auto& g : sim::imuGradeList()) o << "  " << g.first << ": " << g.second << "\n";
   o << "Options (defaults of the nominal scenario):\n"
        "  --num-poses N (12)   --hold-min-s/--hold-max-s S (3/5)   --move-min-s/--move-max-s S "
        "(2/3)\n"
@@ -154,6 +157,14 @@ sim::SimulationConfig configFromArgs(const cia::CliArgs& a) {
   const std::string scenario = a.get("--scenario", "nominal");
   if (!sim::applyScenario(scenario, &c)) {
     throw cia::UsageError("--scenario: unknown scenario '" + scenario + "' (see --help)");
+  }
+  if (a.has("--imu-grade")) {
+    sim::ImuGrade grade;
+    if (!sim::parseImuGrade(a.get("--imu-grade"), &grade)) {
+      throw cia::UsageError("--imu-grade must be ideal, tactical, consumer or noisy, got '" +
+                            a.get("--imu-grade") + "'");
+    }
+    sim::applyImuGrade(grade, &c);
   }
   c.num_poses = static_cast<int>(a.getInt("--num-poses", c.num_poses, 2, 1000));
   c.hold_min_s = a.getDouble("--hold-min-s", c.hold_min_s, 0.1, 600);

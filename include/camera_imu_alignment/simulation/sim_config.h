@@ -11,6 +11,8 @@
 #include <utility>
 #include <vector>
 
+#include "camera_imu_alignment/simulation/imu_grades.h"
+
 namespace camera_imu_alignment {
 namespace simulation {
 
@@ -31,17 +33,6 @@ struct TargetSpec {
   double spacing_m = 0.04;       ///< checkerboard square, circle spacing, aprilgrid tagSize (m)
   double tag_spacing = 0.3;      ///< aprilgrid: gap between tags as a fraction of tagSize
   bool asymmetric_grid = false;  ///< circlegrid only
-};
-
-/// Kalibr imu.yaml noise terms (continuous time), before `noise_scale`.
-struct SensorNoise {
-  double accelerometer_noise_density = 1.86e-3;    ///< m/s^2/sqrt(Hz)
-  double accelerometer_random_walk = 4.33e-4;      ///< m/s^3/sqrt(Hz)
-  double gyroscope_noise_density = 1.87e-4;        ///< rad/s/sqrt(Hz)
-  double gyroscope_random_walk = 2.66e-5;          ///< rad/s^2/sqrt(Hz)
-  double gyroscope_initial_bias_sigma = 5e-3;      ///< rad/s, per axis, drawn once per seed
-  double accelerometer_initial_bias_sigma = 0.05;  ///< m/s^2, per axis, drawn once per seed
-  double magnetometer_noise_sigma = 0.3e-6;        ///< T per sample, per axis
 };
 
 struct SimulationConfig {
@@ -67,11 +58,16 @@ struct SimulationConfig {
 
   // Inertial/magnetic unit.
   double imu_rate_hz = 200.0;
-  double noise_scale = 1.0;  ///< multiplies every sensor noise (IMU, magnetometer, pixels)
-  SensorNoise imu_noise;
+  /// Multiplies every sensor noise (IMU, magnetometer, pixels) and the initial IMU biases; not the
+  /// systematic errors (T_g, T_a, hard and soft iron).
+  double noise_scale = 1.0;
+  ImuGrade imu_grade = ImuGrade::kIdeal;  ///< name of the numbers below (applyImuGrade sets them)
+  SensorNoise imu_noise;                  ///< noise terms of the grade (options may override them)
+  ImuSystematicSigmas imu_systematic;     ///< spread of T_g, T_a, hard and soft iron (imu_grades.h)
   bool magnetometer = true;
   double mag_rate_hz = 100.0;
-  Eigen::Vector3d mag_hard_iron{0.0, 0.0, 0.0};  ///< T, IMU frame, added to every sample
+  Eigen::Vector3d mag_hard_iron{0.0, 0.0, 0.0};  ///< T, IMU frame, added to every sample (and to
+                                                 ///< the grade's drawn hard iron)
   std::vector<int> mag_disturbance_poses;        ///< 0-based poses whose hold is disturbed
   double mag_disturbance_t = 25e-6;              ///< T, magnitude of the extra (world) field
 

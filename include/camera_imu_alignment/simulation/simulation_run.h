@@ -36,6 +36,7 @@ struct SimulationRun {
   std::vector<InertialSample> imu;
   std::vector<MagSample> mag;
   std::vector<MagDisturbance> disturbances;
+  ImuErrors imu_errors;             ///< the unit's drawn errors (drawImuErrors(config))
   std::vector<double> frame_times;  ///< true capture times (s); stamps add camera_time_offset_s
   BadInputPlan bad_input;
 
@@ -45,7 +46,9 @@ struct SimulationRun {
 };
 
 /// The truth YAML (R_cam_imu in the result format of shared/CONVENTIONS.md, stationary intervals
-/// in bag time, per-pose orientations, noise settings, seed, scenario, injections).
+/// in bag time, per-pose orientations, noise settings, seed, scenario, injections) and the
+/// `imu_errors:` block (grade, T_g, T_a, initial biases and walks, hard and soft iron, noise
+/// densities; written with 17 digits, so it reads back exactly).
 std::string truthYaml(const SimulationRun& run);
 
 }  // namespace simulation
