@@ -16,12 +16,12 @@
 #include <sstream>
 
 #include "bag_topics.h"
-#include "camera_imu_alignment/io/default_frames.h"
-#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
 #include "camera_imu_alignment/io/calibration_report.h"
+#include "camera_imu_alignment/io/default_frames.h"
 #include "camera_imu_alignment/io/input_error.h"
-#include "camera_imu_alignment/pipeline/pipeline_config.h"
 #include "camera_imu_alignment/io/result_yaml.h"
+#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/pipeline/pipeline_config.h"
 #include "camera_imu_alignment/ros/message_input.h"
 #include "camera_imu_alignment/ros/wrapper_settings.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
@@ -100,8 +100,8 @@ class RejectLog {
   void operator()(cia::RejectReason reason, cia::InputStream stream, const std::string& detail) {
     const int n = ++shown_[reason];
     if (n <= 3) {
-      std::cerr << "[calibrate_bag] " << topicOf(stream) << ": rejected ("
-                << cia::toString(reason) << "): " << detail << "\n";
+      std::cerr << "[calibrate_bag] " << topicOf(stream) << ": rejected (" << cia::toString(reason)
+                << "): " << detail << "\n";
     }
     if (n == 3) {
       std::cerr << "[calibrate_bag] (further '" << cia::toString(reason)
