@@ -11,8 +11,8 @@
 #include "broad_csv.h"
 #include "camera_imu_alignment/inertial/imu_attitude.h"
 #include "camera_imu_alignment/inertial/magnetometer.h"
-#include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/inertial/stationary_detector.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {
 namespace {

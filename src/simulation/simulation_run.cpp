@@ -8,8 +8,8 @@
 #include <set>
 #include <sstream>
 
-#include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/simulation/target.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {
 namespace simulation {

@@ -16,11 +16,11 @@
 #include <sstream>
 
 #include "bag_topics.h"
-#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
 #include "camera_imu_alignment/io/calibration_report.h"
 #include "camera_imu_alignment/io/input_error.h"
-#include "camera_imu_alignment/pipeline/pipeline_config.h"
 #include "camera_imu_alignment/io/result_yaml.h"
+#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/pipeline/pipeline_config.h"
 #include "camera_imu_alignment/ros/message_input.h"
 #include "camera_imu_alignment/ros/wrapper_settings.h"
 #include "camera_imu_alignment/solver/rotation_math.h"

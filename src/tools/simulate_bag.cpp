@@ -19,10 +19,10 @@
 #include <limits>
 #include <sstream>
 
-#include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/simulation/renderer.h"
 #include "camera_imu_alignment/simulation/simulation_run.h"
 #include "camera_imu_alignment/simulation/target.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 #include "cli_args.h"
 
 namespace cia = camera_imu_alignment;

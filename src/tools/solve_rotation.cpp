@@ -5,10 +5,10 @@
 #include <iomanip>
 #include <iostream>
 
-#include "camera_imu_alignment/solver/alignment_solver.h"
 #include "camera_imu_alignment/io/csv_io.h"
-#include "camera_imu_alignment/solver/pose_window.h"
 #include "camera_imu_alignment/io/result_yaml.h"
+#include "camera_imu_alignment/solver/alignment_solver.h"
+#include "camera_imu_alignment/solver/pose_window.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "cli_args.h"
 

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "camera_imu_alignment/solver/alignment_solver.h"
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/solver/alignment_solver.h"
 
 namespace camera_imu_alignment {
 

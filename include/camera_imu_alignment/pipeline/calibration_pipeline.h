@@ -44,13 +44,13 @@
 #include <string>
 #include <vector>
 
-#include "camera_imu_alignment/solver/alignment_solver.h"
-#include "camera_imu_alignment/vision/camera_model.h"
 #include "camera_imu_alignment/inertial/imu_attitude.h"
 #include "camera_imu_alignment/inertial/inertial_samples.h"
 #include "camera_imu_alignment/inertial/magnetometer.h"
-#include "camera_imu_alignment/solver/pose_window.h"
 #include "camera_imu_alignment/inertial/stationary_detector.h"
+#include "camera_imu_alignment/solver/alignment_solver.h"
+#include "camera_imu_alignment/solver/pose_window.h"
+#include "camera_imu_alignment/vision/camera_model.h"
 #include "camera_imu_alignment/vision/target_detector.h"
 
 namespace camera_imu_alignment {
