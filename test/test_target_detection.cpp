@@ -415,7 +415,7 @@ TEST(CameraPose, RejectsHighReprojectionErrorAndTooFewPoints) {
 // ------------------------------------------------------------------------------ ViSP real data
 
 #ifndef CIA_REALDATA_DIR
-#define CIA_REALDATA_DIR "/work/shared/realdata"
+#error "CIA_REALDATA_DIR (the optional real recordings) is defined by test/CMakeLists.txt"
 #endif
 
 /// ViSP's flange pose file (rows: 6, data: [[tx], [ty], [tz], [tux], [tuy], [tuz]]) -> rotation.
