@@ -1,5 +1,5 @@
 // IMU side of the core: stationary detection, attitude at rest, gyro integration and magnetometer
-// hygiene. Synthetic cases with exact answers, then the real BROAD recordings (../shared/realdata,
+// hygiene. Synthetic cases with exact answers, then the real BROAD recordings (CIA_REALDATA_DIR,
 // skipped when absent) against their motion-capture reference and `moving` labels.
 #include <gtest/gtest.h>
 

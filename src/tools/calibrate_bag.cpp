@@ -1,6 +1,6 @@
 // calibrate_bag: R_cam_imu from a rosbag of a camera + IMU (+ magnetometer) rig, offline, without a
 // roscore. Reads the bag with the rosbag C++ API and drives the core CalibrationPipeline (the same
-// class the nodelet drives). Exit codes (shared/CONVENTIONS.md): 0 success; 2 bad input or usage
+// class the nodelet drives). Exit codes (doc/CONVENTIONS.md): 0 success; 2 bad input or usage
 // (unreadable or truncated bag, missing topic, no camera data, bad target file); 3 not enough
 // information (too few poses, not observable: the message names the axis to rotate about).
 #include <rosbag/bag.h>
@@ -49,7 +49,7 @@ const char* kUsage =
     "  --method M            optimal (default) or two_step (the paper's iteration alone)\n"
     "  --imu-orientation S   auto (default: gyro between poses), magnetometer (the paper's) or\n"
     "                        message (the Imu message's own orientation)\n"
-    "  --output RESULT.yaml  write the result YAML (shared/CONVENTIONS.md) there\n"
+    "  --output RESULT.yaml  write the result YAML there (see doc/CONVENTIONS.md in the package)\n"
     "  --report REPORT.png   write a one-page report: residuals, axis coverage, rests, estimate\n"
     "  --truth TRUTH.yaml    a YAML with R_cam_imu (e.g. simulate_bag's) to print the error to\n"
     "  --quiet               no progress on stderr\n"

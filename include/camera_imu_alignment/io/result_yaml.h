@@ -1,4 +1,4 @@
-// The calibration result YAML of shared/CONVENTIONS.md (R_cam_imu as quaternion_xyzw and matrix,
+// The calibration result YAML of doc/CONVENTIONS.md (R_cam_imu as quaternion_xyzw and matrix,
 // Kalibr-style T_cam_imu with zero translation, quality block), plus extra keys: method, two_step,
 // observability details, per-pair residuals, R_imu_cam.
 #pragma once

@@ -44,7 +44,7 @@ struct SimulationRun {
   std::uint64_t frameNoiseSeed(long j) const;
 };
 
-/// The truth YAML (R_cam_imu in the result format of shared/CONVENTIONS.md, stationary intervals
+/// The truth YAML (R_cam_imu in the result format of doc/CONVENTIONS.md, stationary intervals
 /// in bag time, per-pose orientations, noise settings, seed, scenario, injections).
 std::string truthYaml(const SimulationRun& run);
 
