@@ -32,14 +32,14 @@
 #include <string>
 #include <vector>
 
+#include "camera_imu_alignment/inertial/stationary_detector.h"
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
-#include "camera_imu_alignment/vision/camera_model.h"
 #include "camera_imu_alignment/simulation/renderer.h"
 #include "camera_imu_alignment/simulation/simulation_run.h"
 #include "camera_imu_alignment/simulation/target.h"
-#include "camera_imu_alignment/inertial/stationary_detector.h"
-#include "camera_imu_alignment/vision/target_description.h"
+#include "camera_imu_alignment/vision/camera_model.h"
 #include "camera_imu_alignment/vision/camera_pose.h"
+#include "camera_imu_alignment/vision/target_description.h"
 #include "camera_imu_alignment/vision/target_detector.h"
 
 namespace cia = camera_imu_alignment;

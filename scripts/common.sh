@@ -8,7 +8,7 @@ WS="${REPO_ROOT}/.ws"
 mkdir -p "${WS}"  # the scripts log into it before the first build
 
 # Debian's catkin and pluginlib need Debian's own python3 first on PATH (a pyenv python breaks the
-# configure step: "No module named catkin_pkg"). See ../shared/PLATFORM.md.
+# configure step: "No module named catkin_pkg").
 export PATH="/usr/bin:/bin:/usr/sbin:/sbin:${PATH}"
 export ROS_HOSTNAME=localhost
 export ROS_HOME="${WS}/ros_home"

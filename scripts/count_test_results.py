@@ -1,9 +1,12 @@
 #!/usr/bin/env python3
 """Counts test cases in gtest/rostest XML result files and prints "N passed, N failed".
 
-Usage: count_test_results.py RESULTS_DIR CTEST_EXIT_CODE CTEST_LOG
+Usage: count_test_results.py RESULTS_DIR CTEST_EXIT_CODE CTEST_LOG [CHECKS_FILE]
 A test executable that ctest reports as failed but whose XML shows no failing case (it crashed or
-timed out before writing its results) counts as one failure. Exits 1 on any failure or on no tests.
+timed out before writing its results) counts as one failure. CHECKS_FILE (from scripts/lint) holds
+one "<check> passed|failed" line per further check, each counted as one test; given but missing,
+unreadable or empty, it counts as one failure. Skipped cases are reported on the line before the
+last. The last line is exactly "N passed, N failed". Exits 1 on any failure or on no tests.
 """
 import os
 import re
@@ -50,11 +53,39 @@ def main():
         if not failed_tests and failed == 0:
             crashed = 1
     failed += crashed
-    line = f"{passed} passed, {failed} failed"
+    if len(sys.argv) > 4:
+        check_passed, check_failed = count_checks(sys.argv[4])
+        passed += check_passed
+        failed += check_failed
     if skipped:
-        line += f", {skipped} skipped"
-    print(line)
+        print(f"{skipped} skipped")
+    print(f"{passed} passed, {failed} failed")
     return 1 if failed or passed == 0 else 0
+
+
+def count_checks(path):
+    """(passed, failed) of the "<check> passed|failed" lines of `path`; a missing or empty file, or
+    a line of another form, is one failure."""
+    passed = failed = 0
+    try:
+        with open(path, encoding="utf-8") as checks:
+            lines = [line.split() for line in checks if line.strip()]
+    except OSError as error:
+        print(f"FAILED: checks: cannot read {path} ({error.strerror})")
+        return 0, 1
+    if not lines:
+        print(f"FAILED: checks: no check results in {path}")
+        return 0, 1
+    for words in lines:
+        if len(words) == 2 and words[1] == "passed":
+            passed += 1
+        elif len(words) == 2 and words[1] == "failed":
+            print(f"FAILED: check {words[0]}")
+            failed += 1
+        else:
+            print(f"FAILED: checks: unexpected line '{' '.join(words)}' in {path}")
+            failed += 1
+    return passed, failed
 
 
 if __name__ == "__main__":

@@ -1,5 +1,6 @@
-// Reader of the BROAD benchmark CSV files (../shared/realdata/broad, see its README) into the core
-// library's sample structs, plus the reference orientation and the authors' `moving` label.
+// Reader of the BROAD benchmark CSV files (CIA_REALDATA_DIR/broad, optional real data: see
+// test/CMakeLists.txt; tests skip when absent) into the core library's sample structs, plus the
+// reference orientation and the authors' `moving` label.
 //
 // Columns (found by header name): t_s, gyr_x/y/z (rad/s), acc_x/y/z (m/s^2), mag_x/y/z_uT
 // (microtesla, converted here to tesla), ref_qw/qx/qy/qz (q_ref_imu: IMU-frame vectors into the
@@ -20,7 +21,7 @@
 #include "camera_imu_alignment/inertial/inertial_samples.h"
 
 #ifndef CIA_REALDATA_DIR
-#define CIA_REALDATA_DIR "/work/shared/realdata"
+#error "CIA_REALDATA_DIR (the optional real recordings) is defined by test/CMakeLists.txt"
 #endif
 
 namespace camera_imu_alignment {

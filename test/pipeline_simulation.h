@@ -67,8 +67,7 @@ inline PipelineRun feedPipeline(std::unique_ptr<simulation::SimulationRun> simul
   callbacks.on_reject = [details](RejectReason reason, InputStream stream,
                                   const std::string& detail) {
     if (details->size() < 200) {
-      details->push_back(std::string(toString(stream)) + ": " + toString(reason) +
-                         ": " + detail);
+      details->push_back(std::string(toString(stream)) + ": " + toString(reason) + ": " + detail);
     }
   };
   out.pipeline = std::make_unique<CalibrationPipeline>(target, settings, callbacks);

@@ -1,10 +1,13 @@
 // rostest of the nodelet and of alignment_node (one source, two .test files): simulated bags are
 // played with --clock under use_sim_time; the static tf, the services, a remount and a restart
 // from the saved file are checked against the simulator's truth. Waits poll with wall-clock
-// deadlines (the sim clock stops with the bag); no fixed sleeps decide anything.
+// deadlines (the sim clock stops with the bag); no fixed sleeps decide anything. The further
+// instances some tests start are of the kind the .test file names (~instance_kind): nodelets in
+// alignment_nodelet.test, nodes in alignment_node.test.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <gtest/gtest.h>
+#include <nodelet/NodeletList.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
@@ -15,11 +18,13 @@
 #include <tf2_ros/transform_listener.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <future>
+#include <iostream>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -165,27 +170,73 @@ double bagDuration(const std::string& bag) {
   return r.exit_code == 0 ? std::stod(r.out) : 0.0;
 }
 
-/// A further alignment_node started by a test, named `name`, with `arguments` (parameters and
-/// remaps); stopped when it goes out of scope, also when an assertion ends the test early.
+/// The kind of instance this run tests, from the .test file's ~instance_kind: "node"
+/// (alignment_node.test) or "nodelet" (alignment_nodelet.test). Set in main.
+std::string g_instance_kind;
+
+/// A further instance of the kind under test, named `name`, with `arguments` (private parameters
+/// and remaps); stopped when it goes out of scope, also when an assertion ends the test early.
+/// node: an alignment_node process. nodelet: a nodelet manager `name`_manager and
+/// `nodelet load camera_imu_alignment/AlignmentNodelet` into it, as alignment.launch does (the
+/// loader sets the private parameters and passes the remaps on to the manager); started() then
+/// also means that the manager lists the nodelet as loaded. log() is what the instance printed:
+/// the node's output, or the manager's (where the nodelet writes) and the loader's.
 class ExtraNode {
  public:
   ExtraNode(const std::string& name, const std::string& arguments) : name_(name) {
-    const std::string cmd = std::string(ALIGNMENT_NODE_EXE) + " __name:=" + name +
-                            " _target_file:=" + TARGET_YAML + " " + arguments + " >" + log_path() +
-                            " 2>&1 & echo $! >" + pid_path();
+    const std::string settings =
+        " __name:=" + name + " _target_file:=" + TARGET_YAML + " " + arguments;
+    std::string cmd;
+    if (g_instance_kind == "nodelet") {
+      const std::string manager = name + "_manager";
+      cmd = "rosrun nodelet nodelet manager __name:=" + manager + " >" + path("log") +
+            " 2>&1 & echo $! >" + path("pid") +
+            "; rosrun nodelet nodelet load camera_imu_alignment/AlignmentNodelet " + manager +
+            settings + " >" + path("loader.log") + " 2>&1 & echo $! >" + path("loader.pid");
+    } else {
+      cmd = std::string(ALIGNMENT_NODE_EXE) + settings + " >" + path("log") + " 2>&1 & echo $! >" +
+            path("pid");
+    }
     started_ = std::system(cmd.c_str()) == 0;
+    if (started_ && g_instance_kind == "nodelet") started_ = loadedInto(name + "_manager");
   }
   ~ExtraNode() { stop(); }
-  void stop() const { std::system(("kill $(cat " + pid_path() + ") 2>/dev/null").c_str()); }
+  void stop() const { std::system(("kill " + pids() + " 2>/dev/null").c_str()); }
   bool started() const { return started_; }
+  /// Every process of the instance is running (a nodelet's crash ends its manager).
   bool alive() const {
-    return std::system(("kill -0 $(cat " + pid_path() + ") 2>/dev/null").c_str()) == 0;
+    std::string cmd = "kill -0 $(cat " + path("pid") + ") 2>/dev/null";
+    if (g_instance_kind == "nodelet") cmd += " && kill -0 $(cat " + path("loader.pid") + ")";
+    return std::system((cmd + " 2>/dev/null").c_str()) == 0;
   }
-  std::string log() const { return test::readTextFile(log_path()); }
+  std::string log() const {
+    std::string out = test::readTextFile(path("log"));
+    if (g_instance_kind == "nodelet") out += test::readTextFile(path("loader.log"));
+    return out;
+  }
 
  private:
-  std::string log_path() const { return temp(name_ + ".log"); }
-  std::string pid_path() const { return temp(name_ + ".pid"); }
+  std::string path(const std::string& what) const { return temp(name_ + "." + what); }
+  /// True once `manager` lists this nodelet as loaded (polled for up to 30 s, wall clock).
+  bool loadedInto(const std::string& manager) const {
+    const std::string service = "/" + manager + "/list";
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    if (!ros::service::waitForService(service, ros::Duration(30.0))) return false;
+    while (std::chrono::steady_clock::now() < deadline && ros::ok()) {
+      nodelet::NodeletList list;
+      if (ros::service::call(service, list)) {
+        const auto& loaded = list.response.nodelets;
+        if (std::find(loaded.begin(), loaded.end(), "/" + name_) != loaded.end()) return true;
+      }
+      ros::WallDuration(0.1).sleep();
+    }
+    return false;
+  }
+  std::string pids() const {
+    std::string out = "$(cat " + path("pid") + ")";
+    if (g_instance_kind == "nodelet") out += " $(cat " + path("loader.pid") + ")";
+    return out;
+  }
   std::string name_;
   bool started_ = false;
 };
@@ -306,9 +357,9 @@ TEST_F(AlignmentRos, ManualCaptureTakesOnlyTheArmedRest) {
 }
 
 TEST_F(AlignmentRos, RealImuOnlyBagsKeepItWaitingForTheCameraWithoutATf) {
-  // ../shared/realdata/imu_tools_bags (no camera): a phidgets IMU lying upside down with NaN
-  // magnetometer samples, an AR.Drone, a SparkFun Razor with leading-slash frame ids. Played one
-  // after the other (their clocks jump back) into a node of its own.
+  // CIA_REALDATA_DIR/imu_tools_bags (no camera; skipped when absent): a phidgets IMU lying upside
+  // down with NaN magnetometer samples, an AR.Drone, a SparkFun Razor with leading-slash frame ids.
+  // Played one after the other (their clocks jump back) into a node of its own.
   const std::string dir = std::string(CIA_REALDATA_DIR) + "/imu_tools_bags/";
   if (!std::filesystem::exists(dir)) GTEST_SKIP() << dir << " not found";
   ExtraNode real("real", "_load_on_start:=false _camera_frame:=real_cam _imu_frame:=real_imu" +
@@ -570,5 +621,13 @@ int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "alignment_test");
   ros::NodeHandle nh;  // keeps the node up for the whole run
+  // The extra instances are of the kind under test; a missing or unknown kind fails the run.
+  std::string& kind = camera_imu_alignment::g_instance_kind;
+  if (!ros::param::get("~instance_kind", kind) || (kind != "node" && kind != "nodelet")) {
+    std::cerr << "test_alignment_ros: ~instance_kind must be node or nodelet (set in the .test "
+                 "file), got '"
+              << kind << "'\n";
+    return 1;
+  }
   return RUN_ALL_TESTS();
 }

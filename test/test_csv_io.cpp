@@ -1,4 +1,5 @@
-// CSV readers/writers and the result YAML: formats of CONVENTIONS.md, errors naming file and line.
+// CSV readers/writers and the result YAML: formats of doc/CONVENTIONS.md, errors naming file and
+// line.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -237,7 +238,7 @@ TEST(CsvIo, PairsAndPosesRoundTrip) {
 // Result YAML
 // ------------------------------------------------------------------------------------------------
 
-/// A result with known values (no solver involved), as in CONVENTIONS.md's example.
+/// A result with known values (no solver involved), as in doc/CONVENTIONS.md's example.
 AlignmentResult knownResult(const Eigen::Matrix3d& R) {
   AlignmentResult r;
   r.status = SolveStatus::kOk;

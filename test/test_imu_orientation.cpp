@@ -1,5 +1,5 @@
 // IMU side of the core: stationary detection, attitude at rest, gyro integration and magnetometer
-// hygiene. Synthetic cases with exact answers, then the real BROAD recordings (../shared/realdata,
+// hygiene. Synthetic cases with exact answers, then the real BROAD recordings (CIA_REALDATA_DIR,
 // skipped when absent) against their motion-capture reference and `moving` labels.
 #include <gtest/gtest.h>
 
@@ -11,8 +11,8 @@
 #include "broad_csv.h"
 #include "camera_imu_alignment/inertial/imu_attitude.h"
 #include "camera_imu_alignment/inertial/magnetometer.h"
-#include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/inertial/stationary_detector.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {
 namespace {

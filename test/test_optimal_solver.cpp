@@ -211,7 +211,7 @@ TEST(OptimalSolver, ParsesMethodNames) {
   EXPECT_TRUE(parseSolverMethod("optimal", &m));
   EXPECT_EQ(m, SolverMethod::kOptimal);
   EXPECT_FALSE(parseSolverMethod("Optimal", &m));
-  EXPECT_EQ(toString(SolverMethod::kTwoStep), "two_step");
+  EXPECT_STREQ(toString(SolverMethod::kTwoStep), "two_step");
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// Pose window and the pairs it forms (shared/CONVENTIONS.md: A = R_target_cam_k^T R_target_cam_t,
+// Pose window and the pairs it forms (doc/CONVENTIONS.md: A = R_target_cam_k^T R_target_cam_t,
 // B = R_world_imu_k^T R_world_imu_t, A X = X B with X = R_cam_imu).
 #include <gtest/gtest.h>
 

@@ -12,10 +12,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include "camera_imu_alignment/io/result_yaml.h"
-#include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/simulation/renderer.h"
 #include "camera_imu_alignment/simulation/simulation_run.h"
 #include "camera_imu_alignment/simulation/target.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {
 namespace simulation {

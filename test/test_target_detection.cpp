@@ -12,15 +12,15 @@
 #include <string>
 #include <vector>
 
-#include "camera_imu_alignment/solver/alignment_solver.h"
-#include "camera_imu_alignment/vision/camera_model.h"
 #include "camera_imu_alignment/io/input_error.h"
-#include "camera_imu_alignment/solver/pose_window.h"
-#include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/simulation/renderer.h"
 #include "camera_imu_alignment/simulation/simulation_run.h"
-#include "camera_imu_alignment/vision/target_description.h"
+#include "camera_imu_alignment/solver/alignment_solver.h"
+#include "camera_imu_alignment/solver/pose_window.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
+#include "camera_imu_alignment/vision/camera_model.h"
 #include "camera_imu_alignment/vision/camera_pose.h"
+#include "camera_imu_alignment/vision/target_description.h"
 #include "camera_imu_alignment/vision/target_detector.h"
 
 namespace camera_imu_alignment {

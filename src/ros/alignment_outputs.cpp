@@ -11,8 +11,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "alignment_wrapper_impl.h"
-#include "camera_imu_alignment/io/default_frames.h"
 #include "camera_imu_alignment/AlignmentStatus.h"
+#include "camera_imu_alignment/io/default_frames.h"
 #include "camera_imu_alignment/io/input_error.h"
 #include "camera_imu_alignment/io/result_yaml.h"
 #include "camera_imu_alignment/ros/broadcast_gate.h"

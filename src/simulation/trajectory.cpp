@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/simulation/target.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {
 namespace simulation {

@@ -1,6 +1,6 @@
 // calibrate_bag: R_cam_imu from a rosbag of a camera + IMU (+ magnetometer) rig, offline, without a
 // roscore. Reads the bag with the rosbag C++ API and drives the core CalibrationPipeline (the same
-// class the nodelet drives). Exit codes (shared/CONVENTIONS.md): 0 success; 2 bad input or usage
+// class the nodelet drives). Exit codes (doc/CONVENTIONS.md): 0 success; 2 bad input or usage
 // (unreadable or truncated bag, missing topic, no camera data, bad target file); 3 not enough
 // information (too few poses, not observable: the message names the axis to rotate about).
 #include <rosbag/bag.h>
@@ -16,12 +16,12 @@
 #include <sstream>
 
 #include "bag_topics.h"
-#include "camera_imu_alignment/io/default_frames.h"
-#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
 #include "camera_imu_alignment/io/calibration_report.h"
+#include "camera_imu_alignment/io/default_frames.h"
 #include "camera_imu_alignment/io/input_error.h"
-#include "camera_imu_alignment/pipeline/pipeline_config.h"
 #include "camera_imu_alignment/io/result_yaml.h"
+#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/pipeline/pipeline_config.h"
 #include "camera_imu_alignment/ros/message_input.h"
 #include "camera_imu_alignment/ros/wrapper_settings.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
@@ -49,7 +49,7 @@ const char* kUsage =
     "  --method M            optimal (default) or two_step (the paper's iteration alone)\n"
     "  --imu-orientation S   auto (default: gyro between poses), magnetometer (the paper's) or\n"
     "                        message (the Imu message's own orientation)\n"
-    "  --output RESULT.yaml  write the result YAML (shared/CONVENTIONS.md) there\n"
+    "  --output RESULT.yaml  write the result YAML there (see doc/CONVENTIONS.md in the package)\n"
     "  --report REPORT.png   write a one-page report: residuals, axis coverage, rests, estimate\n"
     "  --truth TRUTH.yaml    a YAML with R_cam_imu (e.g. simulate_bag's) to print the error to\n"
     "  --quiet               no progress on stderr\n"
@@ -100,8 +100,8 @@ class RejectLog {
   void operator()(cia::RejectReason reason, cia::InputStream stream, const std::string& detail) {
     const int n = ++shown_[reason];
     if (n <= 3) {
-      std::cerr << "[calibrate_bag] " << topicOf(stream) << ": rejected ("
-                << cia::toString(reason) << "): " << detail << "\n";
+      std::cerr << "[calibrate_bag] " << topicOf(stream) << ": rejected (" << cia::toString(reason)
+                << "): " << detail << "\n";
     }
     if (n == 3) {
       std::cerr << "[calibrate_bag] (further '" << cia::toString(reason)

@@ -9,7 +9,7 @@
 
 namespace camera_imu_alignment {
 
-/// Exit codes of the tools (shared/CONVENTIONS.md).
+/// Exit codes of the tools (doc/CONVENTIONS.md).
 constexpr int kExitOk = 0;
 constexpr int kExitBadInput = 2;              ///< bad input or usage; the message names the culprit
 constexpr int kExitNotEnoughInformation = 3;  ///< not observable, or the two-step did not fit

@@ -1,14 +1,14 @@
-// solve_rotation: R_cam_imu from a pairs or poses CSV file (shared/CONVENTIONS.md).
+// solve_rotation: R_cam_imu from a pairs or poses CSV file (formats: doc/CONVENTIONS.md).
 // Exit codes: 0 success; 2 bad input or usage; 3 not enough information (not observable).
 #include <Eigen/Geometry>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
 
-#include "camera_imu_alignment/solver/alignment_solver.h"
 #include "camera_imu_alignment/io/csv_io.h"
-#include "camera_imu_alignment/solver/pose_window.h"
 #include "camera_imu_alignment/io/result_yaml.h"
+#include "camera_imu_alignment/solver/alignment_solver.h"
+#include "camera_imu_alignment/solver/pose_window.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "cli_args.h"
 
@@ -36,7 +36,8 @@ const char* kUsage =
     "  --max-poses N        use at most the last N poses (default 100)\n"
     "exit codes: 0 success, 2 bad input or usage, 3 not enough information: not observable (the\n"
     "message names the axis to rotate about), or the two-step settled on a rotation that does not\n"
-    "fit the data\n";
+    "fit the data\n"
+    "file formats, frames and quaternion order: see doc/CONVENTIONS.md in the package\n";
 
 void printSummary(const cia::AlignmentResult& r) {
   const Eigen::Matrix3d& R = r.R_cam_imu;

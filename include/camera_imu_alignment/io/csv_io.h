@@ -1,4 +1,4 @@
-// Readers for the pairs and poses CSV files of shared/CONVENTIONS.md. Columns are found by header
+// Readers for the pairs and poses CSV files of doc/CONVENTIONS.md. Columns are found by header
 // name (any order, extra columns ignored); quaternions are Hamilton (w, x, y, z) and normalised on
 // reading. Every problem is reported as an InputError naming the file and the line.
 #pragma once

@@ -1,4 +1,4 @@
-// The calibration result YAML of shared/CONVENTIONS.md (R_cam_imu as quaternion_xyzw and matrix,
+// The calibration result YAML of doc/CONVENTIONS.md (R_cam_imu as quaternion_xyzw and matrix,
 // Kalibr-style T_cam_imu with zero translation, quality block), plus extra keys: method, two_step,
 // observability details, per-pair residuals, R_imu_cam.
 #pragma once
@@ -14,7 +14,7 @@ namespace camera_imu_alignment {
 
 struct ResultMetadata {
   std::string camera_frame = kDefaultCameraFrame;  ///< image header frame_id
-  std::string imu_frame = kDefaultImuFrame;                 ///< Imu header frame_id
+  std::string imu_frame = kDefaultImuFrame;        ///< Imu header frame_id
   int num_poses = 0;  ///< stationary poses behind the pairs (0: pairs given)
 };
 

@@ -44,14 +44,14 @@
 #include <string>
 #include <vector>
 
-#include "camera_imu_alignment/solver/alignment_solver.h"
-#include "camera_imu_alignment/vision/camera_model.h"
 #include "camera_imu_alignment/inertial/imu_attitude.h"
 #include "camera_imu_alignment/inertial/inertial_samples.h"
-#include "camera_imu_alignment/pipeline/input_rejections.h"
 #include "camera_imu_alignment/inertial/magnetometer.h"
-#include "camera_imu_alignment/solver/pose_window.h"
 #include "camera_imu_alignment/inertial/stationary_detector.h"
+#include "camera_imu_alignment/pipeline/input_rejections.h"
+#include "camera_imu_alignment/solver/alignment_solver.h"
+#include "camera_imu_alignment/solver/pose_window.h"
+#include "camera_imu_alignment/vision/camera_model.h"
 #include "camera_imu_alignment/vision/camera_pose.h"
 #include "camera_imu_alignment/vision/target_detector.h"
 
@@ -122,7 +122,7 @@ struct StationaryPose {
   double reprojection_rms_px = 0.0;  ///< mean over the frames used
   // IMU.
   Eigen::Matrix3d R_world_imu = Eigen::Matrix3d::Identity();  ///< used for the pairs
-  PoseImuSource imu_source = PoseImuSource::kGyro;           ///< where R_world_imu came from
+  PoseImuSource imu_source = PoseImuSource::kGyro;            ///< where R_world_imu came from
   bool magnetometer_usable = false;
   std::string magnetometer_note;  ///< why not usable ("disturbed: dip changed by 5.1 deg", ...)
   std::optional<Eigen::Matrix3d> R_world_imu_accel_mag;  ///< when the field is usable

@@ -6,8 +6,8 @@
 #include <optional>
 #include <string>
 
-#include "camera_imu_alignment/solver/alignment_solver.h"
 #include "camera_imu_alignment/ros/wrapper_settings.h"
+#include "camera_imu_alignment/solver/alignment_solver.h"
 
 namespace camera_imu_alignment {
 

@@ -15,8 +15,8 @@
 #include <optional>
 #include <string>
 
-#include "camera_imu_alignment/vision/camera_model.h"
 #include "camera_imu_alignment/inertial/inertial_samples.h"
+#include "camera_imu_alignment/vision/camera_model.h"
 
 namespace camera_imu_alignment {
 

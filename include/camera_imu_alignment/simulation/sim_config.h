@@ -1,6 +1,6 @@
 // Settings of the camera + inertial/magnetic unit simulator (simulate_bag) and its scenario
 // presets. Units: seconds, metres, radians (names ending in _deg: degrees), tesla for magnetic
-// fields, Hz. Frames (shared/CONVENTIONS.md): world is ENU with gravity (0, 0, -9.81); the camera
+// fields, Hz. Frames (doc/CONVENTIONS.md): world is ENU with gravity (0, 0, -9.81); the camera
 // frame is optical (z forward, x right, y down); R_cam_imu maps IMU vectors into the camera frame.
 #pragma once
 
@@ -25,7 +25,7 @@ enum class MotionKind {
 
 enum class TargetType { kCheckerboard, kAprilgrid, kCirclegrid };
 
-/// Planar target in Kalibr's terms (shared/CONVENTIONS.md "Target description").
+/// Planar target in Kalibr's terms (doc/CONVENTIONS.md "Target description").
 struct TargetSpec {
   TargetType type = TargetType::kCheckerboard;
   int cols = 8;                  ///< checkerboard inner corners / aprilgrid tags / circles along x

@@ -45,7 +45,7 @@ struct SimulationRun {
   std::uint64_t frameNoiseSeed(long j) const;
 };
 
-/// The truth YAML (R_cam_imu in the result format of shared/CONVENTIONS.md, stationary intervals
+/// The truth YAML (R_cam_imu in the result format of doc/CONVENTIONS.md, stationary intervals
 /// in bag time, per-pose orientations, noise settings, seed, scenario, injections) and the
 /// `imu_errors:` block (grade, T_g, T_a, initial biases and walks, hard and soft iron, noise
 /// densities; written with 17 digits, so it reads back exactly).

@@ -30,7 +30,7 @@ std::vector<Eigen::Vector3d> targetPoints(const TargetSpec& target);
 /// Centre of the printed pattern in the target frame (m).
 Eigen::Vector3d targetCentre(const TargetSpec& target);
 
-/// The Kalibr target YAML text (shared/CONVENTIONS.md).
+/// The Kalibr target YAML text (doc/CONVENTIONS.md).
 std::string targetYaml(const TargetSpec& target);
 
 /// Reflectance texture of the printed board, white margin included.

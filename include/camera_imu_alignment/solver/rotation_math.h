@@ -1,6 +1,6 @@
 // SO(3) helpers shared by every solver: exponential and logarithm maps, projection onto SO(3),
 // geodesic angles and the SO(3) Jacobians. Angles are in radians unless a name ends in _deg.
-// Conventions (shared/CONVENTIONS.md): R_a_b maps vectors from frame b into frame a.
+// Conventions (doc/CONVENTIONS.md): R_a_b maps vectors from frame b into frame a.
 #pragma once
 
 #include <Eigen/Core>

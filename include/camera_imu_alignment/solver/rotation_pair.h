@@ -6,7 +6,7 @@
 
 namespace camera_imu_alignment {
 
-/// Relative rotations between two stationary poses k and t (shared/CONVENTIONS.md):
+/// Relative rotations between two stationary poses k and t (doc/CONVENTIONS.md):
 ///   A_cam = R_target_cam_k^T * R_target_cam_t   (camera, from pose t to pose k)
 ///   B_imu = R_world_imu_k^T  * R_world_imu_t    (IMU, same two poses)
 /// They satisfy A_cam * R_cam_imu = R_cam_imu * B_imu.

@@ -19,8 +19,8 @@ struct PoseSettings {
   double min_ambiguity_ratio = 1.5;
 };
 
-/// Camera pose relative to the target (CONVENTIONS: R_target_cam; p_target = R_target_cam p_cam +
-/// p_target_cam).
+/// Camera pose relative to the target (doc/CONVENTIONS.md: R_target_cam; p_target = R_target_cam
+/// p_cam + p_target_cam).
 struct CameraPose {
   Eigen::Matrix3d R_target_cam = Eigen::Matrix3d::Identity();
   Eigen::Vector3d p_target_cam =

@@ -1,4 +1,4 @@
-// Planar calibration targets as described by Kalibr's target YAML files (shared/CONVENTIONS.md),
+// Planar calibration targets as described by Kalibr's target YAML files (doc/CONVENTIONS.md),
 // and the 3-D positions of their feature points in the target frame.
 //
 // Target frame: z = 0 on the printed face, metres; the point order and origin follow Kalibr:

@@ -88,7 +88,6 @@ void writeEstimate(std::ostream& out, const ReportInput& in) {
       << fixedList(rollPitchYawDeg(R), 4) << "\n";
 }
 
-
 void writeQuality(std::ostream& out, const ReportInput& in) {
   const SolutionQuality& q = in.result.quality;
   out << "1-sigma about camera x, y, z (deg): " << fixedList(q.std_dev_deg, 4) << "\n";

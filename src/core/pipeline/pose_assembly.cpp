@@ -250,8 +250,8 @@ std::string CalibrationPipeline::Impl::assessCamera(const StationarySegment& seg
            std::to_string(rotations.size()) + " frames (limit " +
            fmt(settings.max_camera_spread_deg) + ")";
   }
-  pose->R_target_cam = resolveSymmetry(average.mean, pose->R_world_imu, pose->group, poses,
-                                       symmetries);
+  pose->R_target_cam =
+      resolveSymmetry(average.mean, pose->R_world_imu, pose->group, poses, symmetries);
   pose->num_frames = average.num_inliers;
   pose->camera_spread_deg = average.spread_rms_deg;
   pose->reprojection_rms_px = reprojection_sum / static_cast<double>(rotations.size());

@@ -6,8 +6,6 @@
 #include <opencv2/calib3d.hpp>
 #include <sstream>
 
-
-
 namespace camera_imu_alignment {
 
 namespace {
