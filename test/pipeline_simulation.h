@@ -5,12 +5,14 @@
 #include <algorithm>
 #include <limits>
 #include <memory>
+#include <random>
 #include <vector>
 
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
 #include "camera_imu_alignment/simulation/renderer.h"
 #include "camera_imu_alignment/simulation/simulation_run.h"
 #include "camera_imu_alignment/simulation/target.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/vision/target_description.h"
 
 namespace camera_imu_alignment {
@@ -151,6 +153,49 @@ inline PipelineRun runPipeline(const simulation::SimulationConfig& config,
                                const PipelineSettings& settings = {},
                                const Injection& injection = {}) {
   return feedPipeline(std::make_unique<simulation::SimulationRun>(config), settings, injection);
+}
+
+/// A run fed without images: camera orientations given (the truth with `camera_noise_deg` of noise
+/// per axis per frame, at 15 Hz), as through the nodelet's camera_pose topic; optionally the IMU's
+/// own orientation (the truth with 2.5x that noise) in every sample.
+inline std::unique_ptr<CalibrationPipeline> feedWithoutImages(const simulation::SimulationRun& run,
+                                                              const PipelineSettings& settings,
+                                                              double camera_noise_deg,
+                                                              bool imu_orientation = false,
+                                                              unsigned noise_seed = 19) {
+  const Eigen::Matrix3d R_world_target = run.trajectory.R_world_target();
+  auto pipeline = std::make_unique<CalibrationPipeline>(
+      parseTargetYaml(simulation::targetYaml(run.config.target), "target"), settings);
+  std::mt19937 rng(noise_seed);
+  std::normal_distribution<double> noise(0.0, deg2rad(camera_noise_deg));
+  auto jitter = [&](double scale) {
+    return expSO3(scale * Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
+  };
+  std::size_t next_imu = 0, next_mag = 0;
+  auto feedUpTo = [&](double t) {
+    while (next_imu < run.imu.size() && run.imu[next_imu].t <= t) {
+      const auto& s = run.imu[next_imu++];
+      ImuSample sample{s.t, s.gyro, s.accel};
+      if (imu_orientation) {
+        sample.q_world_imu = Eigen::Quaterniond(run.trajectory.at(s.t).R_world_imu() * jitter(2.5));
+      }
+      pipeline->addImu(sample);
+    }
+    while (next_mag < run.mag.size() && run.mag[next_mag].t <= t) {
+      const auto& s = run.mag[next_mag++];
+      pipeline->addMagnetic({s.t, s.field});
+    }
+  };
+  for (double t = 0.0; t < run.imu.back().t; t += 1.0 / 15.0) {
+    feedUpTo(t);
+    CameraFrame frame;
+    frame.stamp_s = t;
+    frame.R_target_cam = R_world_target.transpose() * run.trajectory.at(t).R_world_cam * jitter(1);
+    pipeline->addFrame(frame);
+  }
+  feedUpTo(std::numeric_limits<double>::infinity());
+  pipeline->finish();
+  return pipeline;
 }
 
 }  // namespace test

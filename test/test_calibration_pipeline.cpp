@@ -90,45 +90,10 @@ TEST(CalibrationPipeline, NominalRunFindsEveryPoseAndTheMounting) {
   EXPECT_EQ(r.results.size(), poses.size() - 2);
 }
 
-/// A run fed without images: camera orientations given (the truth with 0.02 deg of noise per frame,
-/// at 15 Hz), as through the nodelet's camera_pose topic; optionally the IMU's own orientation
-/// (the truth with 0.05 deg of noise) in every sample.
 std::unique_ptr<CalibrationPipeline> runWithoutImages(const sim::SimulationRun& run,
                                                       const PipelineSettings& settings,
                                                       bool imu_orientation) {
-  const Eigen::Matrix3d R_world_target = run.trajectory.R_world_target();
-  auto pipeline = std::make_unique<CalibrationPipeline>(
-      parseTargetYaml(sim::targetYaml(run.config.target), "target"), settings);
-  std::mt19937 rng(19);
-  std::normal_distribution<double> noise(0.0, deg2rad(0.02));
-  auto jitter = [&](double scale) {
-    return expSO3(scale * Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
-  };
-  std::size_t next_imu = 0, next_mag = 0;
-  auto feedUpTo = [&](double t) {
-    while (next_imu < run.imu.size() && run.imu[next_imu].t <= t) {
-      const auto& s = run.imu[next_imu++];
-      ImuSample sample{s.t, s.gyro, s.accel};
-      if (imu_orientation) {
-        sample.q_world_imu = Eigen::Quaterniond(run.trajectory.at(s.t).R_world_imu() * jitter(2.5));
-      }
-      pipeline->addImu(sample);
-    }
-    while (next_mag < run.mag.size() && run.mag[next_mag].t <= t) {
-      const auto& s = run.mag[next_mag++];
-      pipeline->addMagnetic({s.t, s.field});
-    }
-  };
-  for (double t = 0.0; t < run.imu.back().t; t += 1.0 / 15.0) {
-    feedUpTo(t);
-    CameraFrame frame;
-    frame.stamp_s = t;
-    frame.R_target_cam = R_world_target.transpose() * run.trajectory.at(t).R_world_cam * jitter(1);
-    pipeline->addFrame(frame);
-  }
-  feedUpTo(std::numeric_limits<double>::infinity());
-  pipeline->finish();
-  return pipeline;
+  return test::feedWithoutImages(run, settings, 0.02, imu_orientation);
 }
 
 std::unique_ptr<sim::SimulationRun> runOf(const std::string& name, std::uint64_t seed) {

@@ -10,7 +10,15 @@
 //   segment end -> StationaryPose (camera: robust average of the frame orientations; IMU: see
 //     below) -> PoseWindow -> solveAlignment -> callbacks.
 //
-// IMU orientation of a pose (rule, PipelineSettings::imu_orientation):
+// R_cam_imu (PipelineSettings::imu_orientation):
+//   kJoint (default): one maximum-likelihood estimate over the window's poses from every sensor
+//     (estimation/joint_estimator.h): the camera orientations, each rest's mean accelerometer and
+//     magnetometer, the raw gyro samples between consecutive poses, with the IMU's own errors
+//     (gyro and accelerometer matrices and biases, hard and soft iron) estimated where the poses
+//     excite them. Each measurement is weighted by its noise as measured on the recording (the
+//     rest's own scatter). It starts from the pair solve below (kAuto's poses).
+//   The other modes solve relative-rotation pairs of the poses with the IMU orientation below.
+// IMU orientation of a pose for the pairs:
 //   kAuto (default): the gyro, integrated bias-corrected from the previous pose (bias: mean of the
 //     two segments' gyro means), chained onto the previous pose's R_world_imu. The chain is
 //     anchored by accelerometer + magnetometer at its first pose (accelerometer alone, heading 0,
@@ -44,6 +52,7 @@
 #include <string>
 #include <vector>
 
+#include "camera_imu_alignment/estimation/joint_types.h"
 #include "camera_imu_alignment/inertial/imu_attitude.h"
 #include "camera_imu_alignment/inertial/inertial_samples.h"
 #include "camera_imu_alignment/inertial/magnetometer.h"
@@ -68,7 +77,7 @@ struct CameraFrame {
   std::optional<Eigen::Matrix3d> R_target_cam;
 };
 
-enum class ImuOrientationSource { kAuto, kMagnetometer, kMessage };
+enum class ImuOrientationSource { kJoint, kAuto, kMagnetometer, kMessage };
 const char* toString(ImuOrientationSource source);
 bool parseImuOrientationSource(const std::string& text, ImuOrientationSource* source);
 
@@ -79,7 +88,8 @@ struct PipelineSettings {
   DetectorSettings detector;
   PoseSettings pose;
   SolverOptions solver;
-  ImuOrientationSource imu_orientation = ImuOrientationSource::kAuto;
+  ImuOrientationSource imu_orientation = ImuOrientationSource::kJoint;
+  JointSettings joint;  ///< the joint estimate (imu_orientation: joint)
   std::size_t window_poses = 30;       ///< sliding window of stationary poses
   int min_poses_to_solve = 3;          ///< solve only with at least this many poses in the window
   int min_frames_per_pose = 2;         ///< camera frames with a pose needed for a stationary pose

@@ -3,8 +3,10 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 
+#include "camera_imu_alignment/estimation/joint_types.h"
 #include "camera_imu_alignment/solver/optimal_solver.h"
 #include "camera_imu_alignment/solver/rotation_pair.h"
 #include "camera_imu_alignment/solver/solution_quality.h"
@@ -51,6 +53,9 @@ struct AlignmentResult {
   int iterations = 0;      ///< iterations of the selected method
   bool converged = false;  ///< the selected method met its convergence test
   SolutionQuality quality;
+  /// The joint estimate (pipeline with imu_orientation: joint): when present and ok, R_cam_imu and
+  /// quality.std_dev_deg are its, the rest of `quality` is the pair solve's.
+  std::optional<JointResult> joint;
 };
 
 /// Solves A_j X = X B_j for X = R_cam_imu.

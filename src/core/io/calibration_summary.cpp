@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "camera_imu_alignment/solver/rotation_math.h"
+#include "camera_imu_alignment/io/joint_yaml.h"
 #include "report_text.h"
 
 namespace camera_imu_alignment {
@@ -88,6 +89,37 @@ void writeEstimate(std::ostream& out, const ReportInput& in) {
       << fixedList(rollPitchYawDeg(R), 4) << "\n";
 }
 
+
+/// The joint estimate: consistency, which IMU errors were estimated or held, what to rotate.
+void writeJoint(std::ostream& out, const JointResult& j) {
+  if (!j.ok) {
+    out << "joint estimate: FAILED (" << j.message << "); the pair solve is reported\n";
+    return;
+  }
+  const double per_dof = j.dof > 0 ? j.chi2 / j.dof : 0.0;
+  out << "joint estimate: chi2/dof " << fixed(per_dof, 2) << " (" << j.dof << " dof, p "
+      << fixed(j.chi2_p_value, 3) << ": "
+      << (j.chi2_p_value >= kConsistencyLevel ? "consistent" : "INCONSISTENT") << ")"
+      << ", " << j.iterations << " iteration(s)\n";
+  const ImuIntrinsics& i = j.intrinsics;
+  const auto state = [](bool estimated) { return estimated ? "estimated" : "held at prior"; };
+  const bool gyro_any = i.gyro_matrix_column_estimated[0] || i.gyro_matrix_column_estimated[1] ||
+                        i.gyro_matrix_column_estimated[2];
+  out << "  gyro scale (%): "
+      << fixedList(100.0 * (i.gyro_matrix.diagonal() - Eigen::Vector3d::Ones()), 3) << " ("
+      << state(gyro_any) << ")\n";
+  out << "  accelerometer bias (m/s^2): " << fixedList(i.accel_bias_m_s2, 4) << " ("
+      << state(i.accel_bias_estimated) << "), scale (%): "
+      << fixedList(100.0 * (i.accel_matrix.diagonal() - Eigen::Vector3d::Ones()), 3) << " ("
+      << state(i.accel_matrix_estimated) << ")\n";
+  if (i.magnetometer_used) {
+    out << "  hard iron (uT): " << fixedList(1e6 * i.hard_iron_t, 3) << " ("
+        << state(i.hard_iron_estimated) << "), soft iron " << state(i.soft_iron_estimated)
+        << "\n";
+  }
+  for (const std::string& note : j.notes) out << "  note: " << note << "\n";
+}
+
 void writeQuality(std::ostream& out, const ReportInput& in) {
   const SolutionQuality& q = in.result.quality;
   out << "1-sigma about camera x, y, z (deg): " << fixedList(q.std_dev_deg, 4) << "\n";
@@ -102,8 +134,9 @@ void writeQuality(std::ostream& out, const ReportInput& in) {
   if (!q.observable && !q.observability_message.empty()) {
     out << "  (" << q.observability_message << ")\n";
   }
-  out << "solver: " << toString(in.result.method) << ", " << in.result.iterations
+  out << "pair solver: " << toString(in.result.method) << ", " << in.result.iterations
       << " iteration(s), " << (in.result.converged ? "converged" : "not converged") << "\n";
+  if (in.result.joint) writeJoint(out, *in.result.joint);
 }
 
 void writePoses(std::ostream& out, const ReportInput& in) {

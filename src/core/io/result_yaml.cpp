@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "camera_imu_alignment/io/csv_io.h"
+#include "camera_imu_alignment/io/joint_yaml.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {
@@ -104,6 +105,7 @@ std::string resultToYaml(const AlignmentResult& r, const ResultMetadata& meta) {
       << "\n";
   out << "    difference_to_result_deg: " << rad2deg(geodesicDistance(r.two_step.R_cam_imu_left, R))
       << "\n";
+  if (r.joint) out << jointToYaml(*r.joint);
   return out.str();
 }
 

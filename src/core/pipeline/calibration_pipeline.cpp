@@ -19,6 +19,8 @@ const char* toString(ImuOrientationSource source) {
       return "magnetometer";
     case ImuOrientationSource::kMessage:
       return "message";
+    case ImuOrientationSource::kJoint:
+      return "joint";
     default:
       return "auto";
   }
@@ -39,7 +41,9 @@ const char* toString(PoseImuSource source) {
 }
 
 bool parseImuOrientationSource(const std::string& text, ImuOrientationSource* source) {
-  if (text == "auto") {
+  if (text == "joint") {
+    *source = ImuOrientationSource::kJoint;
+  } else if (text == "auto") {
     *source = ImuOrientationSource::kAuto;
   } else if (text == "magnetometer") {
     *source = ImuOrientationSource::kMagnetometer;
@@ -134,7 +138,8 @@ CalibrationPipeline::Impl::Impl(const TargetDescription& target_, const Pipeline
       symmetries(detector.symmetries()),
       stationary(settings_.stationary),
       disturbance(settings_.disturbance),
-      window(settings_.window_poses) {}
+      window(settings_.window_poses),
+      joint_window(settings_.window_poses) {}
 
 void CalibrationPipeline::Impl::reject(RejectReason reason, InputStream stream,
                                        const std::string& detail) {
@@ -372,7 +377,10 @@ void CalibrationPipeline::reset(bool clear_counts) {
   }
 }
 
-void CalibrationPipeline::keepNewestPoses(std::size_t count) { impl_->window.keepNewest(count); }
+void CalibrationPipeline::keepNewestPoses(std::size_t count) {
+  impl_->window.keepNewest(count);
+  impl_->joint_window.keepNewest(count);
+}
 std::size_t CalibrationPipeline::windowSize() const { return impl_->window.size(); }
 
 const std::vector<StationaryPose>& CalibrationPipeline::poses() const { return impl_->poses; }

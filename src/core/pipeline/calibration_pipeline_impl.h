@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "joint_window.h"
 
 namespace camera_imu_alignment {
 
@@ -62,6 +63,11 @@ struct CalibrationPipeline::Impl {
   std::vector<StationaryPose> poses;
   std::vector<RejectedPose> rejected;
   PoseWindow window;
+  JointWindow joint_window;  ///< the same poses' measurements for the joint estimate
+  /// Raw gyro samples since the last pose's rest (through rests that became no pose); empty
+  /// optional while there is no pose yet or the gyro chain broke since.
+  std::optional<GyroSegment> joint_gyro_pending;
+  double last_gyro_noise_density = 0.0;  ///< of the previous rest (rad/s/sqrt(Hz))
   std::optional<AlignmentResult> last_result;
 
   std::size_t poses_total = 0, rests_total = 0;
@@ -85,7 +91,11 @@ struct CalibrationPipeline::Impl {
   /// The camera orientation from the frames inside the rest; the reason the rest is no pose, or "".
   std::string assessCamera(const StationarySegment& segment, StationaryPose* pose);
   /// Adds the pose to the history and the window, reports it and solves when enough.
-  void acceptPose(const StationaryPose& pose);
+  void acceptPose(const StationaryPose& pose, JointWindow::Entry joint_entry);
+  /// The rest's measurements for the joint estimate (before the buffers move on); advances
+  /// joint_gyro_pending by the gyro samples since the previous rest.
+  JointWindow::Entry jointMeasurements(const StationarySegment& segment,
+                                       const StationaryPose& pose);
   void solveAndReport();
   AlignmentResult solve() const;
 };

@@ -43,10 +43,21 @@ const std::vector<Key>& keys() {
       {"imu_orientation",
        [](const YAML::Node& node, PipelineSettings* s) {
          if (!parseImuOrientationSource(node.as<std::string>(), &s->imu_orientation)) {
-           throw YAML::Exception(node.Mark(), "must be 'auto', 'magnetometer' or 'message'");
+           throw YAML::Exception(node.Mark(),
+                                 "must be 'joint', 'auto', 'magnetometer' or 'message'");
          }
        }},
       number<double>("accel_weight", [](auto* s) { return &s->accel_weight; }),
+      // Joint estimate: 1-sigma of the priors on the IMU's errors.
+      number<double>("imu_prior_gyro_scale", [](auto* s) { return &s->joint.priors.gyro_scale; }),
+      number<double>("imu_prior_gyro_cross_axis", [](auto* s) { return &s->joint.priors.gyro_cross_axis; }),
+      number<double>("imu_prior_gyro_bias_walk_rad_s_sqrt_s", [](auto* s) { return &s->joint.priors.gyro_bias_walk_rad_s_sqrt_s; }),
+      number<double>("imu_prior_accel_scale", [](auto* s) { return &s->joint.priors.accel_scale; }),
+      number<double>("imu_prior_accel_cross_axis", [](auto* s) { return &s->joint.priors.accel_cross_axis; }),
+      number<double>("imu_prior_accel_bias_m_s2", [](auto* s) { return &s->joint.priors.accel_bias_m_s2; }),
+      number<double>("imu_prior_soft_iron_scale", [](auto* s) { return &s->joint.priors.soft_iron_scale; }),
+      number<double>("imu_prior_soft_iron_cross", [](auto* s) { return &s->joint.priors.soft_iron_cross; }),
+      number<double>("imu_prior_hard_iron_t", [](auto* s) { return &s->joint.priors.hard_iron_t; }),
       // Magnetometer.
       number<double>("mag_scale", [](auto* s) { return &s->magnetometer.scale; }),
       {"mag_hard_iron_t",

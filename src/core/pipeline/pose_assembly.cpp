@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "calibration_pipeline_impl.h"
+#include "camera_imu_alignment/estimation/joint_estimator.h"
 #include "camera_imu_alignment/solver/rotation_average.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 
@@ -37,6 +38,9 @@ SegmentField segmentField(const std::deque<MagneticSample>& samples, double star
 }
 
 constexpr int kMinFieldSamples = 5;
+/// 1-sigma per axis added to a pose's camera orientation (deg): what the frames' scatter cannot
+/// show (intrinsics, the target's flatness).
+constexpr double kCameraSigmaFloorDeg = 0.01;
 
 /// Mean of the IMU's own orientations in [start_s, end_s] (sign-aligned quaternion average); none
 /// with fewer than 5 samples carrying one.
@@ -121,6 +125,7 @@ void CalibrationPipeline::Impl::onSegment(const StationarySegment& segment) {
   pose.gyro_bias_rad_s = segment.gyro_bias_rad_s;
   assessMagnetometer(segment, &pose);
   integrateGyroSincePrevious(segment, &pose);
+  JointWindow::Entry joint_entry = jointMeasurements(segment, pose);
   chooseImuOrientation(segment, &pose);
   const std::string rejection = assessCamera(segment, &pose);
   if (!rejection.empty()) {
@@ -129,7 +134,62 @@ void CalibrationPipeline::Impl::onSegment(const StationarySegment& segment) {
     if (callbacks.on_pose_rejected) callbacks.on_pose_rejected(rejected_pose);
     return;
   }
-  acceptPose(pose);
+  acceptPose(pose, std::move(joint_entry));
+}
+
+JointWindow::Entry CalibrationPipeline::Impl::jointMeasurements(const StationarySegment& segment,
+                                                                const StationaryPose& pose) {
+  JointWindow::Entry entry;
+  JointPose& jp = entry.pose;
+  jp.start_s = segment.start_s;
+  jp.end_s = segment.end_s;
+  const RestStatistics rest = restStatistics(imu_buffer, segment.start_s, segment.end_s);
+  if (rest.count >= 2) {
+    jp.accel_mean_m_s2 = rest.accel_mean_m_s2;
+    jp.accel_mean_cov = rest.accel_mean_cov;
+    jp.gyro_mean_rad_s = rest.gyro_mean_rad_s;
+    jp.gyro_mean_cov = rest.gyro_mean_cov;
+  } else {  // no samples kept (cannot happen for a detected rest): the detector's means
+    jp.accel_mean_m_s2 = segment.mean_accel_m_s2;
+    jp.gyro_mean_rad_s = segment.gyro_bias_rad_s;
+  }
+  if (pose.magnetometer_usable) {
+    if (const auto field =
+            fieldStatistics(mag_buffer, segment.start_s, segment.end_s, kMinFieldSamples)) {
+      jp.mag_mean_t = field->first;
+      jp.mag_mean_cov = field->second;
+    }
+  }
+  // The gyro since the previous rest: linked only while the chain holds (the same coverage test
+  // as the gyro chain's integration).
+  const double density = std::max(rest.gyro_noise_density_rad_s_sqrt_hz, last_gyro_noise_density);
+  if (!pose.R_imu_previous_imu_gyro) {
+    joint_gyro_pending.reset();
+  } else if (joint_gyro_pending) {
+    const GyroSegment chunk =
+        gyroSamplesBetween(imu_buffer, chain_segment.end_s, segment.start_s, density);
+    joint_gyro_pending->stamps_s.insert(joint_gyro_pending->stamps_s.end(), chunk.stamps_s.begin(),
+                                        chunk.stamps_s.end());
+    joint_gyro_pending->gyro_rad_s.insert(joint_gyro_pending->gyro_rad_s.end(),
+                                          chunk.gyro_rad_s.begin(), chunk.gyro_rad_s.end());
+    joint_gyro_pending->noise_density_rad_s_sqrt_hz =
+        std::max(joint_gyro_pending->noise_density_rad_s_sqrt_hz, density);
+    entry.gyro_from_previous = joint_gyro_pending;
+    // Should this rest become no pose, its own samples join the motion to the next pose.
+    const GyroSegment own = gyroSamplesBetween(imu_buffer, segment.start_s, segment.end_s, density);
+    joint_gyro_pending->stamps_s.insert(joint_gyro_pending->stamps_s.end(), own.stamps_s.begin(),
+                                        own.stamps_s.end());
+    joint_gyro_pending->gyro_rad_s.insert(joint_gyro_pending->gyro_rad_s.end(),
+                                          own.gyro_rad_s.begin(), own.gyro_rad_s.end());
+    const auto& stamps = joint_gyro_pending->stamps_s;
+    if (!stamps.empty() && stamps.back() - stamps.front() > settings.max_gyro_span_s) {
+      joint_gyro_pending.reset();  // as long a motion breaks the gyro chain too
+    }
+  }
+  if (rest.gyro_noise_density_rad_s_sqrt_hz > 0.0) {
+    last_gyro_noise_density = rest.gyro_noise_density_rad_s_sqrt_hz;
+  }
+  return entry;
 }
 
 void CalibrationPipeline::Impl::assessMagnetometer(const StationarySegment& segment,
@@ -258,7 +318,18 @@ std::string CalibrationPipeline::Impl::assessCamera(const StationarySegment& seg
   return "";
 }
 
-void CalibrationPipeline::Impl::acceptPose(const StationaryPose& pose) {
+void CalibrationPipeline::Impl::acceptPose(const StationaryPose& pose,
+                                           JointWindow::Entry joint_entry) {
+  // The camera's covariance from the frames' scatter about their average (per axis, of the mean),
+  // with a floor for what the scatter cannot show (intrinsics, the target's flatness).
+  const double spread_rad = deg2rad(pose.camera_spread_deg);
+  const double variance = spread_rad * spread_rad / (3.0 * std::max(1, pose.num_frames)) +
+                          std::pow(deg2rad(kCameraSigmaFloorDeg), 2);
+  joint_entry.pose.R_target_cam = pose.R_target_cam;
+  joint_entry.pose.cov_cam_rad2 = variance * Eigen::Matrix3d::Identity();
+  joint_entry.pose.group = pose.group;
+  joint_window.add(std::move(joint_entry));
+  joint_gyro_pending = GyroSegment{};  // the next motion starts at this rest
   pushBounded(&poses, pose);
   ++poses_total;
   PoseOrientation orientation;
@@ -280,7 +351,27 @@ AlignmentResult CalibrationPipeline::Impl::solve() const {
                      " stationary pose(s) in the window, at least 2 of one group needed";
     return result;
   }
-  return solveAlignment(pairs, settings.solver);
+  AlignmentResult result = solveAlignment(pairs, settings.solver);
+  if (settings.imu_orientation != ImuOrientationSource::kJoint ||
+      result.status == SolveStatus::kBadInput || !result.R_cam_imu.allFinite()) {
+    return result;
+  }
+  // The joint estimate, started from the pair solve.
+  const JointResult joint =
+      JointEstimator(settings.joint).solve(joint_window.problem(), result.R_cam_imu);
+  if (joint.ok) {
+    result.R_cam_imu = joint.R_cam_imu;
+    result.quality.std_dev_deg = joint.std_dev_deg;
+    result.message = "joint estimate over " + std::to_string(joint_window.size()) +
+                     " poses: chi2/dof " + fmt(joint.dof > 0 ? joint.chi2 / joint.dof : 0.0) +
+                     ", 1-sigma [" + fmt(joint.std_dev_deg.x(), 4) + " " +
+                     fmt(joint.std_dev_deg.y(), 4) + " " + fmt(joint.std_dev_deg.z(), 4) +
+                     "] deg; pairs: " + result.message;
+  } else {
+    result.message = "joint estimate failed (" + joint.message + "); pair solve: " + result.message;
+  }
+  result.joint = joint;
+  return result;
 }
 
 void CalibrationPipeline::Impl::solveAndReport() {

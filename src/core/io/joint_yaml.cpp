@@ -1,0 +1,106 @@
+#include "camera_imu_alignment/io/joint_yaml.h"
+
+#include <iomanip>
+#include <sstream>
+
+namespace camera_imu_alignment {
+namespace {
+
+std::string quoted(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+template <typename Derived>
+std::string flow(const Eigen::MatrixBase<Derived>& m) {
+  std::ostringstream out;
+  out << std::setprecision(9);
+  if (m.cols() == 1) {
+    out << "[";
+    for (int i = 0; i < m.rows(); ++i) out << (i ? ", " : "") << m(i);
+    out << "]";
+    return out.str();
+  }
+  out << "[";
+  for (int i = 0; i < m.rows(); ++i) {
+    out << (i ? ", " : "") << "[";
+    for (int k = 0; k < m.cols(); ++k) out << (k ? ", " : "") << m(i, k);
+    out << "]";
+  }
+  out << "]";
+  return out.str();
+}
+
+const char* boolText(bool b) { return b ? "true" : "false"; }
+
+}  // namespace
+
+std::string jointToYaml(const JointResult& j) {
+  std::ostringstream out;
+  out << std::setprecision(9);
+  out << "joint:  # one maximum-likelihood estimate from camera, gravity, field and raw gyro\n";
+  out << "  ok: " << boolText(j.ok) << "\n";
+  out << "  message: " << quoted(j.message) << "\n";
+  out << "  chi2: " << j.chi2 << "\n";
+  out << "  dof: " << j.dof << "\n";
+  out << "  chi2_p_value: " << j.chi2_p_value << "\n";
+  out << "  consistent: " << boolText(j.chi2_p_value >= kConsistencyLevel)
+      << "  # chi-square test at the " << kConsistencyLevel << " level\n";
+  out << "  covariance_scale: " << j.covariance_scale << "  # chi2/dof when > 1, applied\n";
+  out << "  std_dev_deg: " << flow(j.std_dev_deg) << "  # 1-sigma about the camera x, y, z axes\n";
+  out << "  iterations: " << j.iterations << "\n";
+  out << "  solve_time_s: " << j.solve_time_s << "\n";
+  out << "  pose_residual_norm: " << flow(Eigen::Map<const Eigen::VectorXd>(
+                                            j.pose_residual_norm.data(),
+                                            static_cast<Eigen::Index>(j.pose_residual_norm.size())))
+      << "  # per pose, sigma units\n";
+  out << "  suggested_rotation_axis_imu: " << flow(j.suggested_rotation_axis_imu) << "\n";
+  out << "  notes:";
+  for (const std::string& note : j.notes) out << "\n    - " << quoted(note);
+  out << (j.notes.empty() ? " []\n" : "\n");
+  const ImuIntrinsics& i = j.intrinsics;
+  out << "imu_intrinsics:  # w_meas = T_g w + b_g; a_meas = T_a f + b_a; m_meas = S m + h (IMU "
+         "frame = accelerometer axes)\n";
+  out << "  gyro_matrix: {value: " << flow(i.gyro_matrix) << ", sigma: " << flow(i.gyro_matrix_sigma)
+      << ", estimated_columns: [" << boolText(i.gyro_matrix_column_estimated[0]) << ", "
+      << boolText(i.gyro_matrix_column_estimated[1]) << ", "
+      << boolText(i.gyro_matrix_column_estimated[2]) << "]}\n";
+  out << "  gyro_bias_rad_s: {value: " << flow(i.gyro_bias_rad_s)
+      << ", sigma: " << flow(i.gyro_bias_sigma_rad_s) << "}  # at the first pose\n";
+  out << "  accel_matrix: {value: " << flow(i.accel_matrix) << ", sigma: "
+      << flow(i.accel_matrix_sigma) << ", estimated: " << boolText(i.accel_matrix_estimated)
+      << "}\n";
+  out << "  accel_bias_m_s2: {value: " << flow(i.accel_bias_m_s2)
+      << ", sigma: " << flow(i.accel_bias_sigma_m_s2)
+      << ", estimated: " << boolText(i.accel_bias_estimated) << "}\n";
+  out << "  magnetometer_used: " << boolText(i.magnetometer_used) << "\n";
+  out << "  soft_iron: {value: " << flow(i.soft_iron) << ", sigma: " << flow(i.soft_iron_sigma)
+      << ", estimated: " << boolText(i.soft_iron_estimated) << "}\n";
+  out << "  hard_iron_t: {value: " << flow(i.hard_iron_t) << ", sigma: " << flow(i.hard_iron_sigma_t)
+      << ", estimated: " << boolText(i.hard_iron_estimated) << "}\n";
+  return out.str();
+}
+
+std::string kalibrImuYaml(const JointResult& j, double gyro_noise_density_rad_s_sqrt_hz,
+                          double accel_noise_density_m_s2_sqrt_hz, double update_rate_hz,
+                          const std::string& rostopic) {
+  std::ostringstream out;
+  out << std::setprecision(9);
+  out << "# Kalibr imu.yaml (noise densities measured at the recording's rests; random walks are\n"
+         "# not measured by a calibration this short: Kalibr's defaults for a MEMS unit, inflate\n"
+         "# as Kalibr advises). Extra keys: the intrinsics of camera_imu_alignment's joint estimate.\n";
+  out << "accelerometer_noise_density: " << accel_noise_density_m_s2_sqrt_hz << "  # m/s^2/sqrt(Hz)\n";
+  out << "accelerometer_random_walk: 0.0002  # m/s^3/sqrt(Hz)\n";
+  out << "gyroscope_noise_density: " << gyro_noise_density_rad_s_sqrt_hz << "  # rad/s/sqrt(Hz)\n";
+  out << "gyroscope_random_walk: 4.0e-06  # rad/s^2/sqrt(Hz)\n";
+  out << "rostopic: " << rostopic << "\n";
+  out << "update_rate: " << update_rate_hz << "  # Hz\n";
+  out << jointToYaml(j);
+  return out.str();
+}
+
+}  // namespace camera_imu_alignment

@@ -1,0 +1,108 @@
+#include "joint_window.h"
+
+#include <cmath>
+
+namespace camera_imu_alignment {
+
+RestStatistics restStatistics(const std::deque<ImuSample>& samples, double start_s, double end_s) {
+  RestStatistics stats;
+  Eigen::Vector3d accel_sum = Eigen::Vector3d::Zero(), gyro_sum = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (const ImuSample& s : samples) {
+    if (s.stamp_s < start_s || s.stamp_s > end_s) continue;
+    accel_sum += s.accel_m_s2;
+    gyro_sum += s.gyro_rad_s;
+    ++n;
+  }
+  if (n < 2) return stats;
+  stats.count = n;
+  stats.accel_mean_m_s2 = accel_sum / n;
+  stats.gyro_mean_rad_s = gyro_sum / n;
+  Eigen::Matrix3d accel_scatter = Eigen::Matrix3d::Zero(), gyro_scatter = Eigen::Matrix3d::Zero();
+  double diff_sq = 0.0, first_s = 0.0, last_s = 0.0;
+  int diffs = 0;
+  const ImuSample* previous = nullptr;
+  for (const ImuSample& s : samples) {
+    if (s.stamp_s < start_s || s.stamp_s > end_s) continue;
+    const Eigen::Vector3d da = s.accel_m_s2 - stats.accel_mean_m_s2;
+    const Eigen::Vector3d dg = s.gyro_rad_s - stats.gyro_mean_rad_s;
+    accel_scatter += da * da.transpose();
+    gyro_scatter += dg * dg.transpose();
+    if (previous) {
+      diff_sq += (s.gyro_rad_s - previous->gyro_rad_s).squaredNorm();
+      ++diffs;
+      last_s = s.stamp_s;
+    } else {
+      first_s = s.stamp_s;
+    }
+    previous = &s;
+  }
+  stats.accel_mean_cov = accel_scatter / (static_cast<double>(n - 1) * n);
+  stats.gyro_mean_cov = gyro_scatter / (static_cast<double>(n - 1) * n);
+  // White noise: successive differences have twice the per-sample variance (per axis: / 3 / 2);
+  // density = sigma_sample * sqrt(dt).
+  if (diffs > 0 && last_s > first_s) {
+    const double sample_var = diff_sq / (6.0 * diffs);
+    const double dt = (last_s - first_s) / diffs;
+    stats.gyro_noise_density_rad_s_sqrt_hz = std::sqrt(sample_var * dt);
+  }
+  return stats;
+}
+
+std::optional<std::pair<Eigen::Vector3d, Eigen::Matrix3d>> fieldStatistics(
+    const std::deque<MagneticSample>& samples, double start_s, double end_s, int min_count) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (const MagneticSample& s : samples) {
+    if (s.stamp_s < start_s || s.stamp_s > end_s) continue;
+    sum += s.field_t;
+    ++n;
+  }
+  if (n < std::max(2, min_count)) return std::nullopt;
+  const Eigen::Vector3d mean = sum / n;
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const MagneticSample& s : samples) {
+    if (s.stamp_s < start_s || s.stamp_s > end_s) continue;
+    const Eigen::Vector3d d = s.field_t - mean;
+    scatter += d * d.transpose();
+  }
+  return std::make_pair(mean, Eigen::Matrix3d(scatter / (static_cast<double>(n - 1) * n)));
+}
+
+GyroSegment gyroSamplesBetween(const std::deque<ImuSample>& samples, double from_s, double to_s,
+                               double noise_density_rad_s_sqrt_hz) {
+  GyroSegment segment;
+  segment.noise_density_rad_s_sqrt_hz = noise_density_rad_s_sqrt_hz;
+  for (const ImuSample& s : samples) {
+    if (s.stamp_s < from_s || s.stamp_s > to_s) continue;
+    segment.stamps_s.push_back(s.stamp_s);
+    segment.gyro_rad_s.push_back(s.gyro_rad_s);
+  }
+  return segment;
+}
+
+void JointWindow::add(Entry entry) {
+  entries_.push_back(std::move(entry));
+  while (entries_.size() > max_poses_) entries_.pop_front();
+}
+
+void JointWindow::keepNewest(std::size_t count) {
+  while (entries_.size() > count) entries_.pop_front();
+}
+
+JointProblem JointWindow::problem() const {
+  JointProblem problem;
+  for (std::size_t i = 0; i < entries_.size(); ++i) {
+    problem.poses.push_back(entries_[i].pose);
+    const auto& gyro = entries_[i].gyro_from_previous;
+    if (i == 0 || !gyro || gyro->stamps_s.size() < 2) continue;
+    if (entries_[i - 1].pose.group != entries_[i].pose.group) continue;
+    GyroSegment segment = *gyro;
+    segment.from_pose = static_cast<int>(i) - 1;
+    segment.to_pose = static_cast<int>(i);
+    problem.segments.push_back(std::move(segment));
+  }
+  return problem;
+}
+
+}  // namespace camera_imu_alignment
