@@ -1,0 +1,186 @@
+// Input, settings and result of the joint maximum-likelihood estimator (joint_estimator.h).
+//
+// Frames: W is gravity-aligned (z up, gravity (0, 0, -g)); its heading is a free gauge unless the
+// magnetometer is used, then W's +y is magnetic north. The target frame is the calibration
+// target's, the camera frame the image's optical frame, the IMU frame the accelerometer's (the gyro
+// and magnetometer axes are modelled relative to it). R_a_b maps b-frame vectors into frame a.
+//
+// Sensor models (IMU frame; SI units: m/s^2, rad/s, tesla, seconds):
+//   accelerometer at rest  a = T_a R_world_imu^T (0, 0, g) + b_a
+//   gyroscope              w = T_g w_true + b_g(t)
+//   magnetometer           m = S_m R_world_imu^T m_world + h,  m_world = (0, |m| cos dip, -|m| sin
+//   dip)
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace camera_imu_alignment {
+
+/// One stationary pose (a rest) with its averaged measurements.
+struct JointPose {
+  /// Gyro residuals only link consecutive poses of one group (e.g. one recording).
+  int group = 0;
+  double start_s = 0, end_s = 0;  ///< the rest (s)
+  /// Camera in the target frame (PnP average).
+  Eigen::Matrix3d R_target_cam = Eigen::Matrix3d::Identity();
+  /// Covariance of R_target_cam (rad^2, camera axes, right perturbation R Exp(delta)).
+  Eigen::Matrix3d cov_cam_rad2 = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d accel_mean_m_s2 = Eigen::Vector3d::Zero();  ///< IMU frame, mean over the rest
+  Eigen::Matrix3d accel_mean_cov = Eigen::Matrix3d::Zero();   ///< (m/s^2)^2, scatter / N
+  Eigen::Vector3d gyro_mean_rad_s = Eigen::Vector3d::Zero();  ///< raw mean gyro (= bias at rest)
+  Eigen::Matrix3d gyro_mean_cov = Eigen::Matrix3d::Zero();    ///< (rad/s)^2, of that mean
+  std::optional<Eigen::Vector3d> mag_mean_t;  ///< tesla, IMU frame; empty when unusable
+  Eigen::Matrix3d mag_mean_cov = Eigen::Matrix3d::Zero();  ///< T^2, of that mean
+};
+
+/// Raw gyro samples from the end of rest `from_pose` to the start of rest `to_pose`. Sample i holds
+/// over [stamps_s[i], stamps_s[i + 1]); the last one over the segment's median sample interval.
+struct GyroSegment {
+  int from_pose = 0, to_pose = 0;  ///< indices into JointProblem::poses, to_pose = from_pose + 1
+  std::vector<double> stamps_s;    ///< strictly increasing (s)
+  std::vector<Eigen::Vector3d> gyro_rad_s;  ///< raw, gyro axes
+  double noise_density_rad_s_sqrt_hz = 0;   ///< measured white noise (rad/s/sqrt(Hz))
+};
+
+struct JointProblem {
+  std::vector<JointPose> poses;
+  std::vector<GyroSegment> segments;
+};
+
+/// 1-sigma of the Gaussian priors on the IMU parameters (mean: the ideal sensor, T = I, bias 0).
+/// Defaults: a consumer MEMS unit (gyro sensitivity 1.5 %, cross-axis 1 %, accelerometer scale 1 %
+/// and bias 0.2 m/s^2, hard iron 15 uT, soft iron 5 %).
+struct ImuModelPriors {
+  double gyro_scale = 0.015;                  ///< diagonal of T_g - I (dimensionless)
+  double gyro_cross_axis = 0.01;              ///< off-diagonal of T_g (misalignment + cross-axis)
+  double gyro_bias_walk_rad_s_sqrt_s = 1e-4;  ///< bias random walk (rad/s/sqrt(s))
+  double accel_scale = 0.01;                  ///< diagonal of T_a - I
+  double accel_cross_axis = 0.01;             ///< off-diagonal parameters of T_a
+  double accel_bias_m_s2 = 0.2;               ///< each axis of b_a
+  double soft_iron_scale = 0.05;              ///< diagonal of S_m - I
+  double soft_iron_cross = 0.05;              ///< off-diagonal of S_m (symmetric)
+  double hard_iron_t = 15e-6;                 ///< each axis of h (T)
+};
+
+enum class RobustLossKind { kNone, kHuber, kCauchy };
+enum class MagnetometerUse {
+  kAuto,  ///< use it when its hard iron is excited (see JointSettings)
+  kOn,    ///< use every usable pose's field, even with the iron held at its prior
+  kOff
+};
+/// Shape of T_a - I; both leave no rotation (the accelerometer's axes define the IMU frame).
+enum class AccelMatrixForm {
+  kLowerTriangular,  ///< [[sx,0,0],[kyx,sy,0],[kzx,kzy,sz]]: x axis exact, y in the x-y plane
+  kSymmetric         ///< symmetric (polar decomposition without its rotation)
+};
+
+struct JointSettings {
+  ImuModelPriors priors;
+  AccelMatrixForm accel_matrix_form = AccelMatrixForm::kLowerTriangular;
+  /// Robust loss on the camera, accelerometer, magnetometer and gyro residual blocks; the scale is
+  /// in sigma units of the whitened block (|r| below it is unaffected by Huber).
+  RobustLossKind robust_loss = RobustLossKind::kHuber;
+  double robust_loss_scale = 4.0;
+  int max_iterations = 50;       ///< Levenberg-Marquardt iterations per solve
+  int max_relinearisations = 5;  ///< gyro re-preintegrations (outer passes)
+  MagnetometerUse use_magnetometer = MagnetometerUse::kAuto;
+  double gravity_m_s2 = 9.81;
+
+  // Observability: what the poses do not excite is not estimated (estimated = false, a note). By
+  // default such a parameter keeps its prior as a constraint (it stays at its prior mean unless the
+  // data say otherwise, and its prior uncertainty is carried into every covariance, so the 1-sigma
+  // of R_cam_imu still covers it); with pin_unexcited_parameters it is held constant at the prior
+  // mean (SetParameterBlockConstant), and the covariances ignore its uncertainty.
+  bool pin_unexcited_parameters = false;
+  /// A gyro axis' column of T_g (its scale and cross-axis terms) is estimated when the accumulated
+  /// |rotation| about that IMU axis over all motions exceeds this (deg).
+  double min_gyro_axis_rotation_deg = 30.0;
+  /// Coverage of unit directions u_k: sqrt of the smallest eigenvalue of mean(u u^T) (0: all
+  /// along one line, 0.58: spread evenly over the sphere). Spread: the same about their mean
+  /// (sqrt of the smallest eigenvalue of their covariance; 0 for fewer than 4 poses, which lie in
+  /// a plane). The accelerometer bias needs the gravity directions' coverage, T_a - I their spread
+  /// (an affine map needs 4 non-coplanar directions). Defaults: ~9 and ~6 deg of tilt.
+  double min_gravity_coverage_bias = 0.15;
+  double min_gravity_spread_matrix = 0.1;
+  /// Hard iron: at least this many poses with a usable field and its coverage; soft iron: its
+  /// spread (like the accelerometer's bias and matrix).
+  int min_mag_poses_hard_iron = 4;
+  double min_mag_coverage_hard_iron = 0.15;
+  int min_mag_poses_soft_iron = 7;
+  double min_mag_spread_soft_iron = 0.1;
+
+  // Noise floors (added in quadrature to the given covariances; 1-sigma).
+  double accel_mean_sigma_floor_m_s2 = 5e-4;
+  double gyro_mean_sigma_floor_rad_s = 1e-5;
+  double mag_mean_sigma_floor_t = 5e-8;
+  double camera_sigma_floor_rad = 1e-5;
+  double gyro_integration_sigma_floor_rad = 1e-5;
+};
+
+/// One reported parameter block.
+struct EstimatedValue {
+  std::string name;       ///< e.g. "gyro_matrix_column_x", "accel_bias_m_s2"
+  Eigen::VectorXd value;  ///< in the block's units
+  Eigen::VectorXd sigma;  ///< 1-sigma: posterior when estimated, the prior's when held
+  bool estimated = false;
+};
+
+/// The IMU model at the estimate. Sigmas are 1-sigma (posterior, or the prior's when held).
+struct ImuIntrinsics {
+  Eigen::Matrix3d gyro_matrix = Eigen::Matrix3d::Identity();  ///< T_g
+  Eigen::Matrix3d gyro_matrix_sigma = Eigen::Matrix3d::Zero();
+  std::array<bool, 3> gyro_matrix_column_estimated = {false, false, false};  ///< per gyro axis
+  Eigen::Vector3d gyro_bias_rad_s = Eigen::Vector3d::Zero();  ///< at the first pose with gyro data
+  Eigen::Vector3d gyro_bias_sigma_rad_s = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> gyro_bias_per_pose_rad_s;  ///< per pose (the rest mean if unused)
+  Eigen::Matrix3d accel_matrix = Eigen::Matrix3d::Identity();  ///< T_a
+  Eigen::Matrix3d accel_matrix_sigma = Eigen::Matrix3d::Zero();
+  bool accel_matrix_estimated = false;
+  Eigen::Vector3d accel_bias_m_s2 = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_bias_sigma_m_s2 = Eigen::Vector3d::Zero();
+  bool accel_bias_estimated = false;
+  Eigen::Matrix3d soft_iron = Eigen::Matrix3d::Identity();  ///< S_m
+  Eigen::Matrix3d soft_iron_sigma = Eigen::Matrix3d::Zero();
+  bool soft_iron_estimated = false;
+  Eigen::Vector3d hard_iron_t = Eigen::Vector3d::Zero();
+  Eigen::Vector3d hard_iron_sigma_t = Eigen::Vector3d::Zero();
+  bool hard_iron_estimated = false;
+  bool magnetometer_used = false;
+  double magnetic_field_t = 0;  ///< |m_world| (T), when the magnetometer is used
+  double magnetic_dip_rad = 0;  ///< dip (rad, positive downwards), when used
+};
+
+struct JointResult {
+  bool ok = false;
+  std::string message;  ///< why not, when !ok; a summary otherwise
+  Eigen::Matrix3d R_cam_imu = Eigen::Matrix3d::Identity();
+  /// Covariance of the left perturbation R_cam_imu <- Exp(e) R_cam_imu (rad^2, camera axes),
+  /// scaled by chi2 / dof when that is > 1 (covariance_scale).
+  Eigen::Matrix3d covariance_rad2 = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d std_dev_deg = Eigen::Vector3d::Zero();  ///< camera x, y, z axes
+  double covariance_scale = 1.0;  ///< chi2 / dof applied to every covariance (1 when <= 1)
+  Eigen::Matrix3d R_world_target =
+      Eigen::Matrix3d::Identity();  ///< W's yaw: gauge w/o magnetometer
+  ImuIntrinsics intrinsics;
+  std::vector<EstimatedValue> parameters;  ///< every IMU parameter block, estimated or held
+  /// Consistency: chi2 = sum of squared whitened residuals (priors included, no robust loss),
+  /// dof = residuals - free parameters, p-value of chi2 given dof.
+  double chi2 = 0;
+  int dof = 0;
+  double chi2_p_value = 1;
+  /// Per pose: RMS whitened residual (sigma units) over its camera, accelerometer, magnetometer and
+  /// gyro-bias residuals and half of each adjacent gyro residual.
+  std::vector<double> pose_residual_norm;
+  int iterations = 0;        ///< Levenberg-Marquardt iterations over all passes
+  int relinearisations = 0;  ///< gyro preintegration passes
+  double solve_time_s = 0;
+  std::vector<std::string> notes;  ///< what was not estimated and why, what to rotate about
+  /// Unit vector (IMU frame): the rotation axis that would add the most information.
+  Eigen::Vector3d suggested_rotation_axis_imu = Eigen::Vector3d::UnitX();
+};
+
+}  // namespace camera_imu_alignment

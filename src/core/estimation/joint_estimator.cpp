@@ -1,0 +1,185 @@
+#include "camera_imu_alignment/estimation/joint_estimator.h"
+
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+
+#include <Eigen/LU>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <utility>
+
+#include "camera_imu_alignment/estimation/gyro_preintegration.h"
+#include "camera_imu_alignment/estimation/joint_observability.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
+#include "joint_state.h"
+
+namespace camera_imu_alignment {
+namespace {
+
+/// The gyro linearisation is redone until the gyro model moves less than this between passes
+/// (T_g entries, rad/s for the biases): the first-order preintegration error is then ~1e-12 rad.
+constexpr double kRelinearisationThreshold = 1e-6;
+
+std::vector<GyroPreintegration> preintegrateAll(const JointProblem& problem,
+                                                const Eigen::Matrix3d& T_g,
+                                                const std::vector<Eigen::Vector3d>& biases) {
+  std::vector<GyroPreintegration> out;
+  out.reserve(problem.segments.size());
+  for (const GyroSegment& segment : problem.segments) {
+    out.push_back(preintegrateGyro(segment.stamps_s, segment.gyro_rad_s,
+                                   problem.poses[segment.from_pose].end_s,
+                                   problem.poses[segment.to_pose].start_s, T_g,
+                                   biases[segment.from_pose], biases[segment.to_pose]));
+  }
+  return out;
+}
+
+GyroExcitation excitationOf(const std::vector<GyroPreintegration>& segments) {
+  GyroExcitation excitation;
+  excitation.has_segments = !segments.empty();
+  for (const GyroPreintegration& segment : segments) {
+    excitation.accumulated_abs_angle_rad += segment.accumulated_abs_angle_rad;
+    excitation.excitation_rad += segment.excitation_rad;
+  }
+  return excitation;
+}
+
+/// Largest change of the gyro model (T_g entries, biases) since the segments were preintegrated.
+double gyroModelChange(const JointProblem& problem, const joint::State& state,
+                       const std::vector<GyroPreintegration>& segments) {
+  double change = 0.0;
+  const Eigen::Matrix3d T_g = state.gyroMatrix();
+  for (size_t j = 0; j < segments.size(); ++j) {
+    const GyroSegment& segment = problem.segments[j];
+    const GyroModelVector theta =
+        gyroModelVector(T_g, state.gyroBias(segment.from_pose), state.gyroBias(segment.to_pose));
+    change = std::max(change, (theta - segments[j].theta0).cwiseAbs().maxCoeff());
+  }
+  return change;
+}
+
+ceres::Solver::Options solverOptions(const JointSettings& settings) {
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  options.max_num_iterations = settings.max_iterations;
+  // Converged when the cost changes by less than 1e-10 of itself: at chi2 ~ dof that leaves
+  // R_cam_imu within ~1e-8 rad of the minimum (tighter only chases rounding).
+  options.function_tolerance = 1e-10;
+  options.gradient_tolerance = 1e-12;
+  options.parameter_tolerance = 1e-10;
+  options.num_threads = 1;
+  options.logging_type = ceres::SILENT;
+  return options;
+}
+
+std::string summary(const JointProblem& problem, const JointResult& result) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer),
+                "joint estimate: %zu poses, %zu gyro segments, magnetometer %s; chi2/dof %.2f "
+                "(p %.3f); 1-sigma [%.4f %.4f %.4f] deg",
+                problem.poses.size(), problem.segments.size(),
+                result.intrinsics.magnetometer_used ? "used" : "not used",
+                result.dof > 0 ? result.chi2 / result.dof : 0.0, result.chi2_p_value,
+                result.std_dev_deg(0), result.std_dev_deg(1), result.std_dev_deg(2));
+  return buffer;
+}
+
+}  // namespace
+
+JointEstimator::JointEstimator(JointSettings settings) : settings_(std::move(settings)) {}
+
+JointResult JointEstimator::solve(const JointProblem& problem,
+                                  const Eigen::Matrix3d& R_cam_imu_initial) const {
+  const auto start = std::chrono::steady_clock::now();
+  JointResult result;
+  const auto finish = [&](JointResult& r) -> JointResult {
+    r.solve_time_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!r.ok) {
+      r.R_cam_imu = Eigen::Matrix3d::Identity();
+      r.covariance_rad2.setZero();
+      r.std_dev_deg.setZero();
+    }
+    return r;
+  };
+  result.message = joint::validateProblem(problem, R_cam_imu_initial, settings_);
+  if (!result.message.empty()) return finish(result);
+
+  // Preintegrate with the ideal gyro and the rests' biases; decide what the motion excites.
+  const size_t n = problem.poses.size();
+  std::vector<Eigen::Vector3d> biases(n);
+  for (size_t k = 0; k < n; ++k) biases[k] = problem.poses[k].gyro_mean_rad_s;
+  std::vector<GyroPreintegration> gyro =
+      preintegrateAll(problem, Eigen::Matrix3d::Identity(), biases);
+  const JointObservability observability =
+      decideObservability(problem, excitationOf(gyro), settings_);
+  joint::State state = joint::initialState(problem, R_cam_imu_initial, observability, settings_);
+  joint::Whitening whitening;
+  if (!joint::computeWhitening(problem, gyro, settings_, &whitening, &result.message)) {
+    return finish(result);
+  }
+
+  const ceres::Solver::Options options = solverOptions(settings_);
+  bool converged = false;
+  for (int pass = 0; pass < settings_.max_relinearisations; ++pass) {
+    if (pass > 0) {
+      const Eigen::Matrix3d T_g = state.gyroMatrix();
+      if (!T_g.allFinite() || !(std::abs(T_g.determinant()) > 0.5)) {
+        result.message = "the gyro matrix estimate diverged (det T_g far from 1)";
+        return finish(result);
+      }
+      for (size_t k = 0; k < n; ++k) biases[k] = state.gyroBias(static_cast<int>(k));
+      gyro = preintegrateAll(problem, T_g, biases);
+    }
+    ceres::Problem ceres_problem;
+    const joint::BuiltProblem built = joint::buildProblem(problem, gyro, whitening, observability,
+                                                          settings_, &state, &ceres_problem);
+    ceres::Solver::Summary solver_summary;
+    ceres::Solve(options, &ceres_problem, &solver_summary);
+    result.iterations += static_cast<int>(solver_summary.iterations.size());
+    result.relinearisations = pass + 1;
+    if (!solver_summary.IsSolutionUsable()) {
+      result.message = "the solver failed: " + solver_summary.message;
+      return finish(result);
+    }
+    converged = solver_summary.termination_type == ceres::CONVERGENCE;
+    const bool last = pass + 1 == settings_.max_relinearisations ||
+                      gyroModelChange(problem, state, gyro) < kRelinearisationThreshold;
+    if (last) {
+      if (!joint::fillResult(problem, state, built, observability, settings_, &ceres_problem,
+                             &result)) {
+        return finish(result);
+      }
+      state.foldRotationIncrements();
+      break;
+    }
+    state.foldRotationIncrements();
+  }
+
+  result.R_cam_imu = state.R_cam_imu_0;
+  result.R_world_target = state.R_world_target_0;
+  if (!isRotationMatrix(result.R_cam_imu, 1e-6) || !result.covariance_rad2.allFinite()) {
+    result.message = "the estimate is not finite";
+    return finish(result);
+  }
+  result.suggested_rotation_axis_imu = observability.suggested_rotation_axis_imu;
+  result.notes = observability.notes;
+  if (!converged) {
+    result.notes.push_back("the solver stopped before converging (max_iterations " +
+                           std::to_string(settings_.max_iterations) + ")");
+  }
+  if (result.covariance_scale > 1.0) {
+    char buffer[128];
+    std::snprintf(buffer, sizeof(buffer),
+                  "covariances scaled by chi2/dof = %.2f (the residuals exceed their noise)",
+                  result.covariance_scale);
+    result.notes.push_back(buffer);
+  }
+  result.ok = true;
+  result.message = summary(problem, result);
+  return finish(result);
+}
+
+}  // namespace camera_imu_alignment

@@ -1,0 +1,252 @@
+// The Ceres problem of the joint estimator: residuals, priors and what is held (joint_estimator.h).
+#include <ceres/autodiff_cost_function.h>
+#include <ceres/loss_function.h>
+#include <ceres/manifold.h>
+#include <ceres/normal_prior.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "camera_imu_alignment/solver/rotation_math.h"
+#include "joint_residuals.h"
+#include "joint_state.h"
+
+namespace camera_imu_alignment {
+namespace joint {
+namespace {
+
+ceres::LossFunction* makeLoss(const JointSettings& settings) {
+  switch (settings.robust_loss) {
+    case RobustLossKind::kHuber:
+      return new ceres::HuberLoss(settings.robust_loss_scale);
+    case RobustLossKind::kCauchy:
+      return new ceres::CauchyLoss(settings.robust_loss_scale);
+    case RobustLossKind::kNone:
+      break;
+  }
+  return nullptr;
+}
+
+/// Prior (x[i] - 0) / sigma[i] on the entries of a block listed in `entries`.
+ceres::CostFunction* maskedPrior(int block_size, const std::vector<int>& entries,
+                                 const std::vector<double>& sigmas) {
+  ceres::Matrix A = ceres::Matrix::Zero(static_cast<int>(entries.size()), block_size);
+  for (size_t i = 0; i < entries.size(); ++i) A(i, entries[i]) = 1.0 / sigmas[i];
+  return new ceres::NormalPrior(A, ceres::Vector::Zero(block_size));
+}
+
+class Builder {
+ public:
+  Builder(const JointProblem& problem, const Whitening& whitening,
+          const JointObservability& observability, const JointSettings& settings, State* state,
+          ceres::Problem* ceres_problem)
+      : problem_(problem),
+        whitening_(whitening),
+        observability_(observability),
+        settings_(settings),
+        state_(*state),
+        ceres_(*ceres_problem),
+        loss_(makeLoss(settings)),
+        pin_(settings.pin_unexcited_parameters) {}
+
+  BuiltProblem build(const std::vector<GyroPreintegration>& gyro) {
+    const size_t n = problem_.poses.size();
+    addBlock(state_.e_X.data(), 3);
+    addBlock(state_.e_T.data(), 3);
+    // Without the magnetometer, W's yaw is a gauge: hold the increment about world z.
+    if (!observability_.magnetometer_used) {
+      ceres_.SetManifold(state_.e_T.data(), new ceres::SubsetManifold(3, {2}));
+    }
+    for (size_t k = 0; k < n; ++k) addBlock(state_.delta[k].data(), 3);
+    addAccelerometer();
+    if (observability_.magnetometer_used) addMagnetometer();
+    if (!problem_.segments.empty()) addGyro(gyro);
+    return std::move(built_);
+  }
+
+ private:
+  void addBlock(double* block, int size) {
+    ceres_.AddParameterBlock(block, size);
+    built_.free_blocks.push_back(block);
+  }
+
+  void holdBlock(double* block) {
+    ceres_.SetParameterBlockConstant(block);
+    built_.free_blocks.erase(
+        std::remove(built_.free_blocks.begin(), built_.free_blocks.end(), block),
+        built_.free_blocks.end());
+  }
+
+  void record(ceres::ResidualBlockId id, int pose, int other_pose, int size) {
+    built_.residuals.push_back({id, pose, other_pose, size});
+  }
+
+  Eigen::Matrix3d targetCam(size_t k) const {
+    return state_.R_world_target_0 * projectToSO3(problem_.poses[k].R_target_cam);
+  }
+
+  void addAccelerometer() {
+    addBlock(state_.accel_matrix.data(), 6);
+    addBlock(state_.accel_bias.data(), 3);
+    for (size_t k = 0; k < problem_.poses.size(); ++k) {
+      const JointPose& pose = problem_.poses[k];
+      auto* accel =
+          new ceres::AutoDiffCostFunction<AccelResidual, 3, 3, 3, 3, 6, 3>(new AccelResidual{
+              targetCam(k), state_.R_cam_imu_0, pose.accel_mean_m_s2, whitening_.accel[k],
+              settings_.gravity_m_s2, settings_.accel_matrix_form});
+      record(ceres_.AddResidualBlock(accel, loss_, state_.e_T.data(), state_.e_X.data(),
+                                     state_.delta[k].data(), state_.accel_matrix.data(),
+                                     state_.accel_bias.data()),
+             static_cast<int>(k), -1, 3);
+      auto* camera = new ceres::NormalPrior(whitening_.camera[k], ceres::Vector::Zero(3));
+      record(ceres_.AddResidualBlock(camera, loss_, state_.delta[k].data()), static_cast<int>(k),
+             -1, 3);
+    }
+    const ImuModelPriors& p = settings_.priors;
+    if (observability_.accel_matrix_estimated || !pin_) {
+      record(ceres_.AddResidualBlock(
+                 maskedPrior(6, {0, 1, 2, 3, 4, 5},
+                             {p.accel_scale, p.accel_scale, p.accel_scale, p.accel_cross_axis,
+                              p.accel_cross_axis, p.accel_cross_axis}),
+                 nullptr, state_.accel_matrix.data()),
+             -1, -1, 6);
+    } else {
+      holdBlock(state_.accel_matrix.data());
+    }
+    if (observability_.accel_bias_estimated || !pin_) {
+      record(ceres_.AddResidualBlock(
+                 maskedPrior(3, {0, 1, 2}, std::vector<double>(3, p.accel_bias_m_s2)), nullptr,
+                 state_.accel_bias.data()),
+             -1, -1, 3);
+    } else {
+      holdBlock(state_.accel_bias.data());
+    }
+  }
+
+  void addMagnetometer() {
+    addBlock(state_.soft_iron.data(), 6);
+    addBlock(state_.hard_iron_ut.data(), 3);
+    addBlock(state_.field_ut.data(), 2);
+    for (size_t k = 0; k < problem_.poses.size(); ++k) {
+      const JointPose& pose = problem_.poses[k];
+      if (!pose.mag_mean_t) continue;
+      auto* mag = new ceres::AutoDiffCostFunction<MagResidual, 3, 3, 3, 3, 6, 3, 2>(
+          new MagResidual{targetCam(k), state_.R_cam_imu_0, *pose.mag_mean_t * kMicroteslaPerTesla,
+                          whitening_.mag_ut[k]});
+      record(ceres_.AddResidualBlock(mag, loss_, state_.e_T.data(), state_.e_X.data(),
+                                     state_.delta[k].data(), state_.soft_iron.data(),
+                                     state_.hard_iron_ut.data(), state_.field_ut.data()),
+             static_cast<int>(k), -1, 3);
+    }
+    const ImuModelPriors& p = settings_.priors;
+    if (observability_.soft_iron_estimated || !pin_) {
+      record(ceres_.AddResidualBlock(
+                 maskedPrior(6, {0, 1, 2, 3, 4, 5},
+                             {p.soft_iron_scale, p.soft_iron_scale, p.soft_iron_scale,
+                              p.soft_iron_cross, p.soft_iron_cross, p.soft_iron_cross}),
+                 nullptr, state_.soft_iron.data()),
+             -1, -1, 6);
+    } else {
+      holdBlock(state_.soft_iron.data());
+    }
+    if (observability_.hard_iron_estimated || !pin_) {
+      const double sigma_ut = p.hard_iron_t * kMicroteslaPerTesla;
+      record(ceres_.AddResidualBlock(maskedPrior(3, {0, 1, 2}, std::vector<double>(3, sigma_ut)),
+                                     nullptr, state_.hard_iron_ut.data()),
+             -1, -1, 3);
+    } else {
+      holdBlock(state_.hard_iron_ut.data());
+    }
+  }
+
+  void addGyro(const std::vector<GyroPreintegration>& gyro) {
+    const std::vector<bool> with_gyro = posesWithGyro(problem_);
+    const size_t n = problem_.poses.size();
+    addBlock(state_.gyro_matrix.data(), 9);
+    for (size_t k = 0; k < n; ++k) {
+      if (!with_gyro[k]) continue;
+      addBlock(state_.gyro_bias[k].data(), 3);
+      auto* mean =
+          new ceres::NormalPrior(whitening_.gyro_mean[k], problem_.poses[k].gyro_mean_rad_s);
+      record(ceres_.AddResidualBlock(mean, nullptr, state_.gyro_bias[k].data()),
+             static_cast<int>(k), -1, 3);
+    }
+    // Bias random walk between consecutive rests of one group.
+    const double walk = settings_.priors.gyro_bias_walk_rad_s_sqrt_s;
+    for (size_t k = 0; k + 1 < n; ++k) {
+      const JointPose& a = problem_.poses[k];
+      const JointPose& b = problem_.poses[k + 1];
+      if (!with_gyro[k] || !with_gyro[k + 1] || a.group != b.group) continue;
+      const double dt = std::max(0.5 * (b.start_s + b.end_s - a.start_s - a.end_s), 1e-3);
+      auto* cost = new ceres::AutoDiffCostFunction<BiasWalkResidual, 3, 3, 3>(
+          new BiasWalkResidual{1.0 / (walk * std::sqrt(dt))});
+      record(ceres_.AddResidualBlock(cost, nullptr, state_.gyro_bias[k].data(),
+                                     state_.gyro_bias[k + 1].data()),
+             static_cast<int>(k), static_cast<int>(k + 1), 3);
+    }
+    for (size_t j = 0; j < problem_.segments.size(); ++j) {
+      const GyroSegment& segment = problem_.segments[j];
+      const int from = segment.from_pose, to = segment.to_pose;
+      GyroModelVector theta0_minus_identity = gyro[j].theta0;
+      theta0_minus_identity(0) -= 1.0;
+      theta0_minus_identity(4) -= 1.0;
+      theta0_minus_identity(8) -= 1.0;
+      const Eigen::Matrix3d camera_relative =
+          projectToSO3(problem_.poses[from].R_target_cam).transpose() *
+          projectToSO3(problem_.poses[to].R_target_cam);
+      auto* cost = new ceres::AutoDiffCostFunction<GyroResidual, 3, 3, 3, 3, 9, 3, 3>(
+          new GyroResidual{quaternionOf(camera_relative), quaternionOf(state_.R_cam_imu_0),
+                           quaternionOf(gyro[j].delta_R), gyro[j].jacobian, theta0_minus_identity,
+                           whitening_.gyro_relative[j]});
+      record(ceres_.AddResidualBlock(cost, loss_, state_.e_X.data(), state_.delta[from].data(),
+                                     state_.delta[to].data(), state_.gyro_matrix.data(),
+                                     state_.gyro_bias[from].data(), state_.gyro_bias[to].data()),
+             from, to, 3);
+    }
+    // Priors on the columns of T_g - I; with pin_, the columns not excited are held instead.
+    std::vector<int> free_entries, held_entries;
+    std::vector<double> sigmas;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) {
+        if (observability_.gyro_column_estimated[c] || !pin_) {
+          free_entries.push_back(3 * r + c);
+          sigmas.push_back(r == c ? settings_.priors.gyro_scale : settings_.priors.gyro_cross_axis);
+        } else {
+          held_entries.push_back(3 * r + c);
+        }
+      }
+    }
+    if (free_entries.empty()) {
+      holdBlock(state_.gyro_matrix.data());
+      return;
+    }
+    if (!held_entries.empty()) {
+      ceres_.SetManifold(state_.gyro_matrix.data(), new ceres::SubsetManifold(9, held_entries));
+    }
+    record(ceres_.AddResidualBlock(maskedPrior(9, free_entries, sigmas), nullptr,
+                                   state_.gyro_matrix.data()),
+           -1, -1, static_cast<int>(free_entries.size()));
+  }
+
+  const JointProblem& problem_;
+  const Whitening& whitening_;
+  const JointObservability& observability_;
+  const JointSettings& settings_;
+  State& state_;
+  ceres::Problem& ceres_;
+  ceres::LossFunction* loss_;
+  const bool pin_;  // hold what is not excited constant (else it keeps its prior)
+  BuiltProblem built_;
+};
+
+}  // namespace
+
+BuiltProblem buildProblem(const JointProblem& problem, const std::vector<GyroPreintegration>& gyro,
+                          const Whitening& whitening, const JointObservability& observability,
+                          const JointSettings& settings, State* state,
+                          ceres::Problem* ceres_problem) {
+  return Builder(problem, whitening, observability, settings, state, ceres_problem).build(gyro);
+}
+
+}  // namespace joint
+}  // namespace camera_imu_alignment

@@ -1,0 +1,257 @@
+// Covariance, consistency and the reported IMU model of the joint estimator.
+#include <ceres/covariance.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <utility>
+
+#include "camera_imu_alignment/solver/rotation_math.h"
+#include "joint_residuals.h"
+#include "joint_state.h"
+
+namespace camera_imu_alignment {
+namespace joint {
+namespace {
+
+/// Regularised upper incomplete gamma Q(a, x) (Numerical Recipes' series / continued fraction).
+double upperIncompleteGamma(double a, double x) {
+  if (!(x > 0.0)) return 1.0;
+  const double log_prefactor = -x + a * std::log(x) - std::lgamma(a);
+  if (x < a + 1.0) {
+    double term = 1.0 / a, sum = term;
+    for (int n = 1; n < 100000; ++n) {
+      term *= x / (a + n);
+      sum += term;
+      if (std::abs(term) < std::abs(sum) * 1e-15) break;
+    }
+    return std::clamp(1.0 - sum * std::exp(log_prefactor), 0.0, 1.0);
+  }
+  const double tiny = 1e-300;
+  double b = x + 1.0 - a, c = 1.0 / tiny, d = 1.0 / b, h = d;
+  for (int i = 1; i < 100000; ++i) {
+    const double an = -i * (i - a);
+    b += 2.0;
+    d = an * d + b;
+    if (std::abs(d) < tiny) d = tiny;
+    c = b + an / c;
+    if (std::abs(c) < tiny) c = tiny;
+    d = 1.0 / d;
+    const double delta = d * c;
+    h *= delta;
+    if (std::abs(delta - 1.0) < 1e-15) break;
+  }
+  return std::clamp(std::exp(log_prefactor) * h, 0.0, 1.0);
+}
+
+/// Sigmas (sqrt of the covariance diagonal, times sqrt(scale)) of `block`, or the priors' when
+/// the block was not requested (held).
+Eigen::VectorXd blockSigma(const ceres::Covariance& covariance,
+                           const std::map<const double*, int>& requested, const double* block,
+                           const Eigen::VectorXd& prior_sigma, double scale) {
+  const auto it = requested.find(block);
+  if (it == requested.end()) return prior_sigma;
+  const int size = it->second;
+  Eigen::MatrixXd C(size, size);  // row-major from Ceres; only the diagonal is read
+  if (!covariance.GetCovarianceBlock(block, block, C.data())) return prior_sigma;
+  Eigen::VectorXd sigma(size);
+  for (int i = 0; i < size; ++i) sigma(i) = std::sqrt(std::max(0.0, C(i, i) * scale));
+  return sigma;
+}
+
+Eigen::Matrix3d sixToMatrix(const Eigen::VectorXd& p, bool symmetric) {
+  Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
+  M(0, 0) = p(0);
+  M(1, 1) = p(1);
+  M(2, 2) = p(2);
+  M(1, 0) = p(3);
+  M(2, 0) = p(4);
+  M(2, 1) = p(5);
+  if (symmetric) {
+    M(0, 1) = p(3);
+    M(0, 2) = p(4);
+    M(1, 2) = p(5);
+  }
+  return M;
+}
+
+Eigen::VectorXd toVector(const double* values, int size) {
+  return Eigen::Map<const Eigen::VectorXd>(values, size);
+}
+
+}  // namespace
+
+double chiSquareUpperTail(double chi2, int dof) {
+  if (dof <= 0 || !std::isfinite(chi2)) return 1.0;
+  return upperIncompleteGamma(0.5 * dof, 0.5 * chi2);
+}
+
+bool fillResult(const JointProblem& problem, const State& state, const BuiltProblem& built,
+                const JointObservability& observability, const JointSettings& settings,
+                ceres::Problem* ceres_problem, JointResult* result) {
+  // Consistency: plain squared whitened residuals (no robust loss).
+  const size_t n = problem.poses.size();
+  std::vector<double> pose_sum(n, 0.0), pose_count(n, 0.0);
+  double chi2 = 0.0;
+  int residual_count = 0;
+  Eigen::VectorXd r(16);
+  for (const ResidualRecord& record : built.residuals) {
+    double cost = 0.0;
+    r.resize(record.size);
+    ceres_problem->EvaluateResidualBlock(record.id, false, &cost, r.data(), nullptr);
+    const double squared = r.squaredNorm();
+    chi2 += squared;
+    residual_count += record.size;
+    if (record.pose < 0) continue;
+    const double share = record.other_pose >= 0 ? 0.5 : 1.0;
+    pose_sum[record.pose] += share * squared;
+    pose_count[record.pose] += share * record.size;
+    if (record.other_pose >= 0) {
+      pose_sum[record.other_pose] += share * squared;
+      pose_count[record.other_pose] += share * record.size;
+    }
+  }
+  int free_parameters = 0;
+  for (double* block : built.free_blocks) {
+    free_parameters += ceres_problem->ParameterBlockTangentSize(block);
+  }
+  result->chi2 = chi2;
+  result->dof = residual_count - free_parameters;
+  result->chi2_p_value = chiSquareUpperTail(chi2, result->dof);
+  result->pose_residual_norm.assign(n, 0.0);
+  for (size_t k = 0; k < n; ++k) {
+    if (pose_count[k] > 0.0) result->pose_residual_norm[k] = std::sqrt(pose_sum[k] / pose_count[k]);
+  }
+  const double chi2_per_dof = result->dof > 0 ? chi2 / result->dof : 1.0;
+  result->covariance_scale = chi2_per_dof > 1.0 ? chi2_per_dof : 1.0;
+  if (!std::isfinite(result->covariance_scale)) {
+    result->message = "the residuals are not finite at the estimate";
+    return false;
+  }
+
+  // Covariance of R_cam_imu and of every estimated block.
+  std::map<const double*, int> requested;
+  std::vector<std::pair<const double*, const double*>> pairs;
+  for (double* block : built.free_blocks) {
+    if (block == state.e_T.data()) continue;
+    bool is_delta = false;
+    for (const auto& d : state.delta) is_delta = is_delta || block == d.data();
+    if (is_delta) continue;
+    requested[block] = ceres_problem->ParameterBlockSize(block);
+    pairs.emplace_back(block, block);
+  }
+  ceres::Covariance::Options options;
+  options.num_threads = 1;
+  ceres::Covariance covariance(options);
+  bool computed = covariance.Compute(pairs, ceres_problem);
+  std::unique_ptr<ceres::Covariance> fallback;
+  const ceres::Covariance* used = &covariance;
+  if (!computed) {
+    // Rank-deficient for the sparse QR: the dense SVD reports it through its pseudo-inverse.
+    options.algorithm_type = ceres::DENSE_SVD;
+    fallback = std::make_unique<ceres::Covariance>(options);
+    computed = fallback->Compute(pairs, ceres_problem);
+    used = fallback.get();
+  }
+  Eigen::Matrix<double, 3, 3, Eigen::RowMajor> cov_x;
+  if (!computed || !used->GetCovarianceBlock(state.e_X.data(), state.e_X.data(), cov_x.data()) ||
+      !cov_x.allFinite()) {
+    result->message = "the covariance of R_cam_imu cannot be computed (the problem is degenerate)";
+    return false;
+  }
+  result->covariance_rad2 = cov_x * result->covariance_scale;
+  result->covariance_rad2 = 0.5 * (result->covariance_rad2 + result->covariance_rad2.transpose());
+  for (int i = 0; i < 3; ++i) {
+    result->std_dev_deg(i) = rad2deg(std::sqrt(std::max(0.0, result->covariance_rad2(i, i))));
+  }
+
+  // The IMU model.
+  const ImuModelPriors& p = settings.priors;
+  const double scale = result->covariance_scale;
+  ImuIntrinsics& in = result->intrinsics;
+  const bool symmetric = settings.accel_matrix_form == AccelMatrixForm::kSymmetric;
+  Eigen::VectorXd accel_prior(6), soft_prior(6), gyro_prior(9);
+  accel_prior << p.accel_scale, p.accel_scale, p.accel_scale, p.accel_cross_axis,
+      p.accel_cross_axis, p.accel_cross_axis;
+  soft_prior << p.soft_iron_scale, p.soft_iron_scale, p.soft_iron_scale, p.soft_iron_cross,
+      p.soft_iron_cross, p.soft_iron_cross;
+  for (int i = 0; i < 9; ++i) gyro_prior(i) = i % 4 == 0 ? p.gyro_scale : p.gyro_cross_axis;
+
+  const Eigen::VectorXd accel_sigma =
+      blockSigma(*used, requested, state.accel_matrix.data(), accel_prior, scale);
+  in.accel_matrix =
+      Eigen::Matrix3d::Identity() + sixToMatrix(toVector(state.accel_matrix.data(), 6), symmetric);
+  in.accel_matrix_sigma = sixToMatrix(accel_sigma, symmetric);
+  in.accel_matrix_estimated = observability.accel_matrix_estimated;
+  const Eigen::VectorXd accel_bias_sigma =
+      blockSigma(*used, requested, state.accel_bias.data(),
+                 Eigen::Vector3d::Constant(p.accel_bias_m_s2), scale);
+  in.accel_bias_m_s2 = toVector(state.accel_bias.data(), 3);
+  in.accel_bias_sigma_m_s2 = accel_bias_sigma;
+  in.accel_bias_estimated = observability.accel_bias_estimated;
+
+  const bool has_gyro = !problem.segments.empty();
+  Eigen::VectorXd gyro_sigma =
+      blockSigma(*used, requested, state.gyro_matrix.data(), gyro_prior, scale);
+  for (int c = 0; c < 3; ++c) {
+    in.gyro_matrix_column_estimated[c] = has_gyro && observability.gyro_column_estimated[c];
+    for (int r = 0; r < 3; ++r) {
+      const bool held = !in.gyro_matrix_column_estimated[c] && settings.pin_unexcited_parameters;
+      if (held || !has_gyro) gyro_sigma(3 * r + c) = gyro_prior(3 * r + c);
+    }
+  }
+  in.gyro_matrix = state.gyroMatrix();
+  in.gyro_matrix_sigma =
+      Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(gyro_sigma.data());
+  in.gyro_bias_per_pose_rad_s.clear();
+  for (size_t k = 0; k < n; ++k)
+    in.gyro_bias_per_pose_rad_s.push_back(state.gyroBias(static_cast<int>(k)));
+  const std::vector<bool> with_gyro = posesWithGyro(problem);
+  const auto first = std::find(with_gyro.begin(), with_gyro.end(), true);
+  const int first_pose = first == with_gyro.end() ? 0 : static_cast<int>(first - with_gyro.begin());
+  in.gyro_bias_rad_s = state.gyroBias(first_pose);
+  in.gyro_bias_sigma_rad_s =
+      blockSigma(*used, requested, state.gyro_bias[first_pose].data(),
+                 problem.poses[first_pose].gyro_mean_cov.diagonal().cwiseSqrt(), scale);
+
+  in.magnetometer_used = observability.magnetometer_used;
+  in.soft_iron_estimated = observability.magnetometer_used && observability.soft_iron_estimated;
+  in.hard_iron_estimated = observability.magnetometer_used && observability.hard_iron_estimated;
+  const Eigen::VectorXd soft_sigma =
+      blockSigma(*used, requested, state.soft_iron.data(), soft_prior, scale);
+  in.soft_iron =
+      Eigen::Matrix3d::Identity() + sixToMatrix(toVector(state.soft_iron.data(), 6), true);
+  in.soft_iron_sigma = sixToMatrix(soft_sigma, true);
+  in.hard_iron_t = toVector(state.hard_iron_ut.data(), 3) / kMicroteslaPerTesla;
+  in.hard_iron_sigma_t =
+      blockSigma(*used, requested, state.hard_iron_ut.data(),
+                 Eigen::Vector3d::Constant(p.hard_iron_t * kMicroteslaPerTesla), scale) /
+      kMicroteslaPerTesla;
+  if (observability.magnetometer_used) {
+    in.magnetic_field_t = std::hypot(state.field_ut[0], state.field_ut[1]) / kMicroteslaPerTesla;
+    in.magnetic_dip_rad = std::atan2(-state.field_ut[1], state.field_ut[0]);
+  }
+
+  // The same as a list, one entry per block.
+  auto add = [&](const std::string& name, const Eigen::VectorXd& value,
+                 const Eigen::VectorXd& sigma, bool estimated) {
+    result->parameters.push_back({name, value, sigma, estimated});
+  };
+  const char* axes[3] = {"x", "y", "z"};
+  for (int c = 0; c < 3; ++c) {
+    add(std::string("gyro_matrix_column_") + axes[c], in.gyro_matrix.col(c),
+        in.gyro_matrix_sigma.col(c), in.gyro_matrix_column_estimated[c]);
+  }
+  add("gyro_bias_rad_s", in.gyro_bias_rad_s, in.gyro_bias_sigma_rad_s, has_gyro);
+  add("accel_matrix_minus_identity", toVector(state.accel_matrix.data(), 6), accel_sigma,
+      in.accel_matrix_estimated);
+  add("accel_bias_m_s2", in.accel_bias_m_s2, in.accel_bias_sigma_m_s2, in.accel_bias_estimated);
+  add("soft_iron_minus_identity", toVector(state.soft_iron.data(), 6), soft_sigma,
+      in.soft_iron_estimated);
+  add("hard_iron_t", in.hard_iron_t, in.hard_iron_sigma_t, in.hard_iron_estimated);
+  return true;
+}
+
+}  // namespace joint
+}  // namespace camera_imu_alignment

@@ -1,0 +1,219 @@
+// Cost functors of the joint estimator (private to src/core/estimation), for ceres::AutoDiff.
+//
+// Parameter blocks (all Euclidean; rotations as increments relinearised between passes):
+//   e_X (3)     R_cam_imu = Exp(e_X) X0              (rad, camera axes: left perturbation)
+//   e_T (3)     R_world_target = Exp(e_T) T0         (rad, world axes; z held without magnetometer)
+//   delta_k (3) R_target_cam_k' = R_target_cam_k Exp(delta_k)   (rad, camera axes)
+//   accel_matrix (6)  T_a - I (AccelMatrixForm);  accel_bias (3) m/s^2
+//   gyro_matrix (9)   T_g - I, row-major;         gyro_bias_k (3) rad/s, per pose
+//   soft_iron (6)     S_m - I symmetric: [xx, yy, zz, xy, xz, yz]
+//   hard_iron (3) uT;  field (2) uT: m_world = (0, field[0], field[1])
+// Magnetic quantities are in microtesla inside the estimator (well-scaled for the solver).
+// Every residual is whitened: r = L^-1 (measured - model) with L L^T the measurement covariance.
+#pragma once
+
+#include <ceres/rotation.h>
+
+#include <Eigen/Core>
+#include <array>
+
+#include "camera_imu_alignment/estimation/gyro_preintegration.h"
+#include "camera_imu_alignment/estimation/joint_types.h"
+
+namespace camera_imu_alignment {
+namespace joint {
+
+template <typename T>
+using Matrix3 = Eigen::Matrix<T, 3, 3>;
+template <typename T>
+using Vector3 = Eigen::Matrix<T, 3, 1>;
+
+template <typename T>
+Matrix3<T> expRotation(const T* rotvec) {
+  Matrix3<T> R;
+  ceres::AngleAxisToRotationMatrix(rotvec, ceres::ColumnMajorAdapter3x3(R.data()));
+  return R;
+}
+
+template <typename T>
+Vector3<T> logRotation(const Matrix3<T>& R) {
+  Vector3<T> rotvec;
+  ceres::RotationMatrixToAngleAxis(ceres::ColumnMajorAdapter3x3(R.data()), rotvec.data());
+  return rotvec;
+}
+
+/// T_a = I + the 6 parameters in the chosen form.
+template <typename T>
+Matrix3<T> accelMatrix(const T* p, AccelMatrixForm form) {
+  Matrix3<T> M = Matrix3<T>::Identity();
+  M(0, 0) += p[0];
+  M(1, 1) += p[1];
+  M(2, 2) += p[2];
+  M(1, 0) = p[3];
+  M(2, 0) = p[4];
+  M(2, 1) = p[5];
+  if (form == AccelMatrixForm::kSymmetric) {
+    M(0, 1) = p[3];
+    M(0, 2) = p[4];
+    M(1, 2) = p[5];
+  } else {
+    M(0, 1) = T(0.0);
+    M(0, 2) = T(0.0);
+    M(1, 2) = T(0.0);
+  }
+  return M;
+}
+
+/// S_m = I + symmetric [xx, yy, zz, xy, xz, yz].
+template <typename T>
+Matrix3<T> softIronMatrix(const T* p) {
+  Matrix3<T> M;
+  M << T(1.0) + p[0], p[3], p[4], p[3], T(1.0) + p[1], p[5], p[4], p[5], T(1.0) + p[2];
+  return M;
+}
+
+/// T_g = I + the 9 row-major parameters.
+template <typename T>
+Matrix3<T> gyroMatrix(const T* p) {
+  Matrix3<T> M;
+  M << T(1.0) + p[0], p[1], p[2], p[3], T(1.0) + p[4], p[5], p[6], p[7], T(1.0) + p[8];
+  return M;
+}
+
+/// R_world_imu_k^T v_world for R_world_imu_k = Exp(e_T) T0 R_target_cam_k Exp(delta_k) Exp(e_X) X0,
+/// as a chain of vector rotations (cheaper with Jets than the matrix product).
+template <typename T>
+Vector3<T> imuFromWorld(const Eigen::Matrix3d& T0_target_cam, const Eigen::Matrix3d& X0,
+                        const T* e_T, const T* delta, const T* e_X, const Vector3<T>& v_world) {
+  const T minus_e_T[3] = {-e_T[0], -e_T[1], -e_T[2]};
+  const T minus_delta[3] = {-delta[0], -delta[1], -delta[2]};
+  const T minus_e_X[3] = {-e_X[0], -e_X[1], -e_X[2]};
+  Vector3<T> a, b;
+  ceres::AngleAxisRotatePoint(minus_e_T, v_world.data(), a.data());
+  b = T0_target_cam.transpose().cast<T>() * a;
+  ceres::AngleAxisRotatePoint(minus_delta, b.data(), a.data());
+  ceres::AngleAxisRotatePoint(minus_e_X, a.data(), b.data());
+  return X0.transpose().cast<T>() * b;
+}
+
+/// Accelerometer mean at a rest: a = T_a R_world_imu^T (0, 0, g) + b_a.
+struct AccelResidual {
+  Eigen::Matrix3d T0_target_cam, X0;  // T0 R_target_cam_k and X0
+  Eigen::Vector3d accel_m_s2;
+  Eigen::Matrix3d whitening;  // L^-1
+  double gravity_m_s2;
+  AccelMatrixForm form;
+
+  template <typename T>
+  bool operator()(const T* e_T, const T* e_X, const T* delta, const T* accel_matrix,
+                  const T* accel_bias, T* residual) const {
+    const Vector3<T> up_world(T(0.0), T(0.0), T(gravity_m_s2));
+    const Vector3<T> specific_force = imuFromWorld(T0_target_cam, X0, e_T, delta, e_X, up_world);
+    const Vector3<T> model =
+        accelMatrix(accel_matrix, form) * specific_force + Eigen::Map<const Vector3<T>>(accel_bias);
+    Eigen::Map<Vector3<T>> out(residual);
+    out = whitening.cast<T>() * (accel_m_s2.cast<T>() - model);
+    return true;
+  }
+};
+
+/// Magnetometer mean at a rest (uT): m = S_m R_world_imu^T (0, f0, f1) + h.
+struct MagResidual {
+  Eigen::Matrix3d T0_target_cam, X0;
+  Eigen::Vector3d mag_ut;
+  Eigen::Matrix3d whitening;  // 1/uT
+
+  template <typename T>
+  bool operator()(const T* e_T, const T* e_X, const T* delta, const T* soft_iron,
+                  const T* hard_iron_ut, const T* field_ut, T* residual) const {
+    const Vector3<T> m_world(T(0.0), field_ut[0], field_ut[1]);
+    const Vector3<T> m_imu = imuFromWorld(T0_target_cam, X0, e_T, delta, e_X, m_world);
+    const Vector3<T> model =
+        softIronMatrix(soft_iron) * m_imu + Eigen::Map<const Vector3<T>>(hard_iron_ut);
+    Eigen::Map<Vector3<T>> out(residual);
+    out = whitening.cast<T>() * (mag_ut.cast<T>() - model);
+    return true;
+  }
+};
+
+/// Hamilton quaternion [w, x, y, z] of a rotation matrix.
+inline std::array<double, 4> quaternionOf(const Eigen::Matrix3d& R) {
+  std::array<double, 4> q;
+  ceres::RotationMatrixToQuaternion(ceres::ColumnMajorAdapter3x3(R.data()), q.data());
+  return q;
+}
+
+/// Relative rotation between consecutive rests from the gyro vs from camera + R_cam_imu:
+/// r = Log(DeltaR(theta)^T R_world_imu_k^T R_world_imu_k+1); R_world_target cancels. Evaluated
+/// with quaternions (cheaper with Jets).
+struct GyroResidual {
+  std::array<double, 4> q_camera_relative;  // of R_target_cam_k^T R_target_cam_k+1
+  std::array<double, 4> q_X0;
+  std::array<double, 4> q_delta_R0;       // DeltaR preintegrated at theta0
+  GyroPreintegrationJacobian jacobian;    // d Log / d theta
+  GyroModelVector theta0_minus_identity;  // theta0 with I subtracted from T_g's entries
+  Eigen::Matrix3d whitening;              // 1/rad
+
+  template <typename T>
+  static void multiply(const T* a, const T* b, T* ab) {
+    ceres::QuaternionProduct(a, b, ab);
+  }
+
+  template <typename T>
+  bool operator()(const T* e_X, const T* delta_from, const T* delta_to, const T* gyro_matrix,
+                  const T* bias_from, const T* bias_to, T* residual) const {
+    T q_e[4], q_X[4], q_X_inverse[4], q_from[4], q_to[4], a[4], b[4];
+    const T q_X0_t[4] = {T(q_X0[0]), T(q_X0[1]), T(q_X0[2]), T(q_X0[3])};
+    ceres::AngleAxisToQuaternion(e_X, q_e);
+    multiply(q_e, q_X0_t, q_X);
+    q_X_inverse[0] = q_X[0];
+    for (int i = 1; i < 4; ++i) q_X_inverse[i] = -q_X[i];
+    const T minus_delta_from[3] = {-delta_from[0], -delta_from[1], -delta_from[2]};
+    ceres::AngleAxisToQuaternion(minus_delta_from, q_from);
+    ceres::AngleAxisToQuaternion(delta_to, q_to);
+    const T q_A[4] = {T(q_camera_relative[0]), T(q_camera_relative[1]), T(q_camera_relative[2]),
+                      T(q_camera_relative[3])};
+    // imu_relative = X^T Exp(-delta_from) A Exp(delta_to) X
+    multiply(q_X_inverse, q_from, a);
+    multiply(a, q_A, b);
+    multiply(b, q_to, a);
+    T q_imu_relative[4];
+    multiply(a, q_X, q_imu_relative);
+
+    Eigen::Matrix<T, kGyroModelSize, 1> dtheta;
+    for (int i = 0; i < 9; ++i) dtheta(i) = gyro_matrix[i] - T(theta0_minus_identity(i));
+    for (int i = 0; i < 3; ++i) {
+      dtheta(9 + i) = bias_from[i] - T(theta0_minus_identity(9 + i));
+      dtheta(12 + i) = bias_to[i] - T(theta0_minus_identity(12 + i));
+    }
+    const Vector3<T> correction = jacobian.cast<T>() * dtheta;
+    T q_correction[4], q_gyro[4];
+    ceres::AngleAxisToQuaternion(correction.data(), q_correction);
+    const T q_D0[4] = {T(q_delta_R0[0]), T(-q_delta_R0[1]), T(-q_delta_R0[2]), T(-q_delta_R0[3])};
+    // gyro_relative^T = Exp(-correction) DeltaR0^T
+    q_correction[1] = -q_correction[1];
+    q_correction[2] = -q_correction[2];
+    q_correction[3] = -q_correction[3];
+    multiply(q_correction, q_D0, q_gyro);
+    multiply(q_gyro, q_imu_relative, a);
+    Vector3<T> error;
+    ceres::QuaternionToAngleAxis(a, error.data());
+    Eigen::Map<Vector3<T>> out(residual);
+    out = whitening.cast<T>() * error;
+    return true;
+  }
+};
+
+/// Gyro bias random walk between consecutive rests: r = (b_to - b_from) / sigma.
+struct BiasWalkResidual {
+  double inverse_sigma;  // 1 / (walk * sqrt(dt))
+
+  template <typename T>
+  bool operator()(const T* bias_from, const T* bias_to, T* residual) const {
+    for (int i = 0; i < 3; ++i) residual[i] = (bias_to[i] - bias_from[i]) * T(inverse_sigma);
+    return true;
+  }
+};
+
+}  // namespace joint
+}  // namespace camera_imu_alignment

@@ -1,0 +1,242 @@
+// Input checks and measurement whitening of the joint estimator.
+#include <Eigen/Cholesky>
+#include <cmath>
+#include <set>
+#include <utility>
+
+#include "camera_imu_alignment/solver/rotation_math.h"
+#include "joint_state.h"
+
+namespace camera_imu_alignment {
+namespace joint {
+namespace {
+
+std::string poseName(size_t k) { return "pose " + std::to_string(k); }
+
+bool finitePositive(double x) { return std::isfinite(x) && x > 0.0; }
+
+bool usableCovariance(const Eigen::Matrix3d& covariance, double floor_sigma) {
+  Eigen::Matrix3d unused;
+  if (!covariance.allFinite()) return false;
+  const double scale = covariance.cwiseAbs().maxCoeff();
+  if ((covariance - covariance.transpose()).cwiseAbs().maxCoeff() > 1e-9 * scale + 1e-300) {
+    return false;
+  }
+  return whiteningMatrix(covariance, floor_sigma, &unused);
+}
+
+std::string validateSettings(const JointSettings& s) {
+  const ImuModelPriors& p = s.priors;
+  for (double sigma : {p.gyro_scale, p.gyro_cross_axis, p.gyro_bias_walk_rad_s_sqrt_s,
+                       p.accel_scale, p.accel_cross_axis, p.accel_bias_m_s2, p.soft_iron_scale,
+                       p.soft_iron_cross, p.hard_iron_t}) {
+    if (!finitePositive(sigma)) return "settings: every prior sigma must be finite and > 0";
+  }
+  for (double floor :
+       {s.accel_mean_sigma_floor_m_s2, s.gyro_mean_sigma_floor_rad_s, s.mag_mean_sigma_floor_t,
+        s.camera_sigma_floor_rad, s.gyro_integration_sigma_floor_rad}) {
+    if (!finitePositive(floor)) return "settings: every noise floor must be finite and > 0";
+  }
+  if (!finitePositive(s.gravity_m_s2)) return "settings: gravity_m_s2 must be finite and > 0";
+  if (!finitePositive(s.robust_loss_scale)) return "settings: robust_loss_scale must be > 0";
+  if (s.max_iterations < 1 || s.max_relinearisations < 1) {
+    return "settings: max_iterations and max_relinearisations must be >= 1";
+  }
+  for (double t :
+       {s.min_gyro_axis_rotation_deg, s.min_gravity_coverage_bias, s.min_gravity_spread_matrix,
+        s.min_mag_coverage_hard_iron, s.min_mag_spread_soft_iron}) {
+    if (!std::isfinite(t)) return "settings: observability thresholds must be finite";
+  }
+  return "";
+}
+
+std::string validatePose(const JointPose& pose, size_t k, const JointSettings& s) {
+  const std::string name = poseName(k);
+  if (!std::isfinite(pose.start_s) || !std::isfinite(pose.end_s) || pose.end_s < pose.start_s) {
+    return name + ": the rest's start_s and end_s must be finite with start_s <= end_s";
+  }
+  if (!isRotationMatrix(pose.R_target_cam, 1e-3)) {
+    return name + ": R_target_cam is not a rotation matrix";
+  }
+  if (!usableCovariance(pose.cov_cam_rad2, s.camera_sigma_floor_rad)) {
+    return name + ": cov_cam_rad2 is not a finite symmetric positive semi-definite matrix";
+  }
+  if (!pose.accel_mean_m_s2.allFinite()) return name + ": accelerometer mean is not finite";
+  const double accel_norm = pose.accel_mean_m_s2.norm();
+  if (accel_norm < 0.5 * s.gravity_m_s2 || accel_norm > 2.0 * s.gravity_m_s2) {
+    return name + ": accelerometer mean of " + std::to_string(accel_norm) +
+           " m/s^2 is not gravity (not at rest, or not in m/s^2)";
+  }
+  if (!usableCovariance(pose.accel_mean_cov, s.accel_mean_sigma_floor_m_s2)) {
+    return name + ": accel_mean_cov is not a finite symmetric positive semi-definite matrix";
+  }
+  if (!pose.gyro_mean_rad_s.allFinite()) return name + ": gyro mean is not finite";
+  if (!usableCovariance(pose.gyro_mean_cov, s.gyro_mean_sigma_floor_rad_s)) {
+    return name + ": gyro_mean_cov is not a finite symmetric positive semi-definite matrix";
+  }
+  if (pose.mag_mean_t) {
+    const double norm = pose.mag_mean_t->norm();
+    if (!pose.mag_mean_t->allFinite() || !(norm > 0.0)) {
+      return name + ": magnetometer mean is not finite and non-zero";
+    }
+    if (norm > 1e-2) {
+      return name + ": magnetometer mean of " + std::to_string(norm) +
+             " T is not in tesla (the earth's field is ~5e-5 T)";
+    }
+    if (!usableCovariance(pose.mag_mean_cov, s.mag_mean_sigma_floor_t)) {
+      return name + ": mag_mean_cov is not a finite symmetric positive semi-definite matrix";
+    }
+  }
+  return "";
+}
+
+std::string validateSegment(const GyroSegment& segment, size_t j, const JointProblem& problem) {
+  const std::string name = "gyro segment " + std::to_string(j);
+  const int n = static_cast<int>(problem.poses.size());
+  if (segment.from_pose < 0 || segment.from_pose >= n || segment.to_pose != segment.from_pose + 1 ||
+      segment.to_pose >= n) {
+    return name + ": needs 0 <= from_pose and to_pose = from_pose + 1 < number of poses";
+  }
+  const JointPose& from = problem.poses[segment.from_pose];
+  const JointPose& to = problem.poses[segment.to_pose];
+  if (from.group != to.group) return name + ": joins poses of different groups";
+  if (to.start_s < from.end_s) return name + ": its second rest starts before the first one ends";
+  if (segment.stamps_s.size() < 2) return name + ": fewer than 2 gyro samples";
+  if (segment.stamps_s.size() != segment.gyro_rad_s.size()) {
+    return name + ": stamps_s and gyro_rad_s differ in length";
+  }
+  for (size_t i = 0; i < segment.stamps_s.size(); ++i) {
+    if (!std::isfinite(segment.stamps_s[i]) || !segment.gyro_rad_s[i].allFinite()) {
+      return name + ": sample " + std::to_string(i) + " is not finite";
+    }
+    if (i > 0 && !(segment.stamps_s[i] > segment.stamps_s[i - 1])) {
+      return name + ": stamps are not strictly increasing at sample " + std::to_string(i);
+    }
+  }
+  if (segment.stamps_s.back() - segment.stamps_s.front() > 3600.0) {
+    return name + ": longer than an hour";
+  }
+  if (!std::isfinite(segment.noise_density_rad_s_sqrt_hz) ||
+      segment.noise_density_rad_s_sqrt_hz < 0.0) {
+    return name + ": noise_density_rad_s_sqrt_hz must be finite and >= 0";
+  }
+  return "";
+}
+
+}  // namespace
+
+std::string validateProblem(const JointProblem& problem, const Eigen::Matrix3d& R_cam_imu_initial,
+                            const JointSettings& settings) {
+  std::string error = validateSettings(settings);
+  if (!error.empty()) return error;
+  if (problem.poses.size() < 3) {
+    return "needs at least 3 poses (got " + std::to_string(problem.poses.size()) + ")";
+  }
+  if (!isRotationMatrix(R_cam_imu_initial, 1e-3)) {
+    return "R_cam_imu_initial is not a rotation matrix";
+  }
+  for (size_t k = 0; k < problem.poses.size(); ++k) {
+    error = validatePose(problem.poses[k], k, settings);
+    if (!error.empty()) return error;
+  }
+  std::set<int> from_poses;
+  for (size_t j = 0; j < problem.segments.size(); ++j) {
+    error = validateSegment(problem.segments[j], j, problem);
+    if (!error.empty()) return error;
+    if (!from_poses.insert(problem.segments[j].from_pose).second) {
+      return "gyro segment " + std::to_string(j) + ": a second segment between poses " +
+             std::to_string(problem.segments[j].from_pose) + " and " +
+             std::to_string(problem.segments[j].to_pose);
+    }
+  }
+  return "";
+}
+
+bool whiteningMatrix(const Eigen::Matrix3d& covariance, double floor_sigma,
+                     Eigen::Matrix3d* whitening) {
+  const Eigen::Matrix3d C = 0.5 * (covariance + covariance.transpose()) +
+                            floor_sigma * floor_sigma * Eigen::Matrix3d::Identity();
+  if (!C.allFinite()) return false;
+  Eigen::LLT<Eigen::Matrix3d> llt(C);
+  if (llt.info() != Eigen::Success) return false;
+  const Eigen::Matrix3d L = llt.matrixL();
+  if (!(L.diagonal().minCoeff() > 0.0)) return false;
+  *whitening = L.triangularView<Eigen::Lower>().solve(Eigen::Matrix3d::Identity());
+  return whitening->allFinite();
+}
+
+bool computeWhitening(const JointProblem& problem, const std::vector<GyroPreintegration>& segments,
+                      const JointSettings& settings, Whitening* w, std::string* error) {
+  const size_t n = problem.poses.size();
+  w->accel.assign(n, Eigen::Matrix3d::Zero());
+  w->gyro_mean.assign(n, Eigen::Matrix3d::Zero());
+  w->mag_ut.assign(n, Eigen::Matrix3d::Zero());
+  w->camera.assign(n, Eigen::Matrix3d::Zero());
+  const double walk = settings.priors.gyro_bias_walk_rad_s_sqrt_s;
+  for (size_t k = 0; k < n; ++k) {
+    const JointPose& pose = problem.poses[k];
+    // The bias at the rest's ends differs from its mean by the walk: variance walk^2 T / 3.
+    const double rest_s = pose.end_s - pose.start_s;
+    const Eigen::Matrix3d gyro_cov =
+        pose.gyro_mean_cov + (walk * walk * rest_s / 3.0) * Eigen::Matrix3d::Identity();
+    const double ut2 = kMicroteslaPerTesla * kMicroteslaPerTesla;
+    bool ok =
+        whiteningMatrix(pose.accel_mean_cov, settings.accel_mean_sigma_floor_m_s2, &w->accel[k]) &&
+        whiteningMatrix(gyro_cov, settings.gyro_mean_sigma_floor_rad_s, &w->gyro_mean[k]) &&
+        whiteningMatrix(pose.cov_cam_rad2, settings.camera_sigma_floor_rad, &w->camera[k]);
+    if (ok && pose.mag_mean_t) {
+      ok = whiteningMatrix(pose.mag_mean_cov * ut2,
+                           settings.mag_mean_sigma_floor_t * kMicroteslaPerTesla, &w->mag_ut[k]);
+    }
+    if (!ok) {
+      *error = "pose " + std::to_string(k) + ": a measurement covariance is not usable";
+      return false;
+    }
+  }
+  w->gyro_relative.assign(problem.segments.size(), Eigen::Matrix3d::Zero());
+  for (size_t j = 0; j < problem.segments.size(); ++j) {
+    const double density = problem.segments[j].noise_density_rad_s_sqrt_hz;
+    const double T = segments[j].duration_s;
+    // White noise integrated over T, plus the walk's deviation from the linear bias ramp (a
+    // Brownian bridge: the integral's variance is walk^2 T^3 / 12).
+    const double variance = density * density * T + walk * walk * T * T * T / 12.0;
+    if (!whiteningMatrix(variance * Eigen::Matrix3d::Identity(),
+                         settings.gyro_integration_sigma_floor_rad, &w->gyro_relative[j])) {
+      *error = "gyro segment " + std::to_string(j) + ": its noise is not usable";
+      return false;
+    }
+  }
+  return true;
+}
+
+std::vector<bool> posesWithGyro(const JointProblem& problem) {
+  std::vector<bool> used(problem.poses.size(), false);
+  for (const GyroSegment& segment : problem.segments) {
+    used[segment.from_pose] = true;
+    used[segment.to_pose] = true;
+  }
+  return used;
+}
+
+Eigen::Matrix3d State::gyroMatrix() const {
+  Eigen::Matrix3d T_g;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) T_g(r, c) = (r == c ? 1.0 : 0.0) + gyro_matrix[3 * r + c];
+  }
+  return T_g;
+}
+
+Eigen::Vector3d State::gyroBias(int pose) const {
+  return Eigen::Vector3d(gyro_bias[pose][0], gyro_bias[pose][1], gyro_bias[pose][2]);
+}
+
+void State::foldRotationIncrements() {
+  R_cam_imu_0 = projectToSO3(expSO3(Eigen::Vector3d(e_X[0], e_X[1], e_X[2])) * R_cam_imu_0);
+  R_world_target_0 =
+      projectToSO3(expSO3(Eigen::Vector3d(e_T[0], e_T[1], e_T[2])) * R_world_target_0);
+  e_X = {0.0, 0.0, 0.0};
+  e_T = {0.0, 0.0, 0.0};
+}
+
+}  // namespace joint
+}  // namespace camera_imu_alignment
