@@ -30,7 +30,8 @@ struct Outcome {
   }
 };
 
-/// The grade's priors for the joint estimate (a user sets them for the unit in config/default.yaml).
+/// The grade's priors for the joint estimate (a user sets them for the unit in
+/// config/default.yaml).
 JointSettings settingsFor(const sim::SimulationConfig& c) {
   JointSettings s;
   const auto& e = c.imu_systematic;
@@ -80,10 +81,11 @@ Outcome monteCarlo(const std::string& scenario, int seeds, std::uint64_t first_s
     const Eigen::Matrix3d& P = r.joint->covariance_rad2;
     for (int a = 0; a < 3; ++a) out.z.push_back(e(a) / std::sqrt(P(a, a)));
   }
-  std::printf("%-16s %2d/%2d solved  RMS %.4f deg  max %.4f deg  (pairs: RMS %.4f)  "
-              "within 1 sigma %.2f, 3 sigma %.3f\n",
-              scenario.c_str(), out.solved, out.runs, out.rms(), out.max_deg, out.rmsPairs(),
-              out.fractionWithin(1.0), out.fractionWithin(3.0));
+  std::printf(
+      "%-16s %2d/%2d solved  RMS %.4f deg  max %.4f deg  (pairs: RMS %.4f)  "
+      "within 1 sigma %.2f, 3 sigma %.3f\n",
+      scenario.c_str(), out.solved, out.runs, out.rms(), out.max_deg, out.rmsPairs(),
+      out.fractionWithin(1.0), out.fractionWithin(3.0));
   return out;
 }
 

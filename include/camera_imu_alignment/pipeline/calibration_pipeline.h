@@ -89,7 +89,7 @@ struct PipelineSettings {
   PoseSettings pose;
   SolverOptions solver;
   ImuOrientationSource imu_orientation = ImuOrientationSource::kJoint;
-  JointSettings joint;  ///< the joint estimate (imu_orientation: joint)
+  JointSettings joint;                 ///< the joint estimate (imu_orientation: joint)
   std::size_t window_poses = 30;       ///< sliding window of stationary poses
   int min_poses_to_solve = 3;          ///< solve only with at least this many poses in the window
   int min_frames_per_pose = 2;         ///< camera frames with a pose needed for a stationary pose

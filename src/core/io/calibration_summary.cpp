@@ -7,8 +7,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/io/joint_yaml.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 #include "report_text.h"
 
 namespace camera_imu_alignment {
@@ -89,7 +89,6 @@ void writeEstimate(std::ostream& out, const ReportInput& in) {
       << fixedList(rollPitchYawDeg(R), 4) << "\n";
 }
 
-
 /// The joint estimate: consistency, which IMU errors were estimated or held, what to rotate.
 void writeJoint(std::ostream& out, const JointResult& j) {
   if (!j.ok) {
@@ -114,8 +113,7 @@ void writeJoint(std::ostream& out, const JointResult& j) {
       << state(i.accel_matrix_estimated) << ")\n";
   if (i.magnetometer_used) {
     out << "  hard iron (uT): " << fixedList(1e6 * i.hard_iron_t, 3) << " ("
-        << state(i.hard_iron_estimated) << "), soft iron " << state(i.soft_iron_estimated)
-        << "\n";
+        << state(i.hard_iron_estimated) << "), soft iron " << state(i.soft_iron_estimated) << "\n";
   }
   for (const std::string& note : j.notes) out << "  note: " << note << "\n";
 }

@@ -54,9 +54,9 @@ std::string jointToYaml(const JointResult& j) {
   out << "  std_dev_deg: " << flow(j.std_dev_deg) << "  # 1-sigma about the camera x, y, z axes\n";
   out << "  iterations: " << j.iterations << "\n";
   out << "  solve_time_s: " << j.solve_time_s << "\n";
-  out << "  pose_residual_norm: " << flow(Eigen::Map<const Eigen::VectorXd>(
-                                            j.pose_residual_norm.data(),
-                                            static_cast<Eigen::Index>(j.pose_residual_norm.size())))
+  out << "  pose_residual_norm: "
+      << flow(Eigen::Map<const Eigen::VectorXd>(
+             j.pose_residual_norm.data(), static_cast<Eigen::Index>(j.pose_residual_norm.size())))
       << "  # per pose, sigma units\n";
   out << "  suggested_rotation_axis_imu: " << flow(j.suggested_rotation_axis_imu) << "\n";
   out << "  notes:";
@@ -65,22 +65,24 @@ std::string jointToYaml(const JointResult& j) {
   const ImuIntrinsics& i = j.intrinsics;
   out << "imu_intrinsics:  # w_meas = T_g w + b_g; a_meas = T_a f + b_a; m_meas = S m + h (IMU "
          "frame = accelerometer axes)\n";
-  out << "  gyro_matrix: {value: " << flow(i.gyro_matrix) << ", sigma: " << flow(i.gyro_matrix_sigma)
-      << ", estimated_columns: [" << boolText(i.gyro_matrix_column_estimated[0]) << ", "
+  out << "  gyro_matrix: {value: " << flow(i.gyro_matrix)
+      << ", sigma: " << flow(i.gyro_matrix_sigma) << ", estimated_columns: ["
+      << boolText(i.gyro_matrix_column_estimated[0]) << ", "
       << boolText(i.gyro_matrix_column_estimated[1]) << ", "
       << boolText(i.gyro_matrix_column_estimated[2]) << "]}\n";
   out << "  gyro_bias_rad_s: {value: " << flow(i.gyro_bias_rad_s)
       << ", sigma: " << flow(i.gyro_bias_sigma_rad_s) << "}  # at the first pose\n";
-  out << "  accel_matrix: {value: " << flow(i.accel_matrix) << ", sigma: "
-      << flow(i.accel_matrix_sigma) << ", estimated: " << boolText(i.accel_matrix_estimated)
-      << "}\n";
+  out << "  accel_matrix: {value: " << flow(i.accel_matrix)
+      << ", sigma: " << flow(i.accel_matrix_sigma)
+      << ", estimated: " << boolText(i.accel_matrix_estimated) << "}\n";
   out << "  accel_bias_m_s2: {value: " << flow(i.accel_bias_m_s2)
       << ", sigma: " << flow(i.accel_bias_sigma_m_s2)
       << ", estimated: " << boolText(i.accel_bias_estimated) << "}\n";
   out << "  magnetometer_used: " << boolText(i.magnetometer_used) << "\n";
   out << "  soft_iron: {value: " << flow(i.soft_iron) << ", sigma: " << flow(i.soft_iron_sigma)
       << ", estimated: " << boolText(i.soft_iron_estimated) << "}\n";
-  out << "  hard_iron_t: {value: " << flow(i.hard_iron_t) << ", sigma: " << flow(i.hard_iron_sigma_t)
+  out << "  hard_iron_t: {value: " << flow(i.hard_iron_t)
+      << ", sigma: " << flow(i.hard_iron_sigma_t)
       << ", estimated: " << boolText(i.hard_iron_estimated) << "}\n";
   return out.str();
 }
@@ -92,8 +94,10 @@ std::string kalibrImuYaml(const JointResult& j, double gyro_noise_density_rad_s_
   out << std::setprecision(9);
   out << "# Kalibr imu.yaml (noise densities measured at the recording's rests; random walks are\n"
          "# not measured by a calibration this short: Kalibr's defaults for a MEMS unit, inflate\n"
-         "# as Kalibr advises). Extra keys: the intrinsics of camera_imu_alignment's joint estimate.\n";
-  out << "accelerometer_noise_density: " << accel_noise_density_m_s2_sqrt_hz << "  # m/s^2/sqrt(Hz)\n";
+         "# as Kalibr advises). Extra keys: the intrinsics of camera_imu_alignment's joint "
+         "estimate.\n";
+  out << "accelerometer_noise_density: " << accel_noise_density_m_s2_sqrt_hz
+      << "  # m/s^2/sqrt(Hz)\n";
   out << "accelerometer_random_walk: 0.0002  # m/s^3/sqrt(Hz)\n";
   out << "gyroscope_noise_density: " << gyro_noise_density_rad_s_sqrt_hz << "  # rad/s/sqrt(Hz)\n";
   out << "gyroscope_random_walk: 4.0e-06  # rad/s^2/sqrt(Hz)\n";
