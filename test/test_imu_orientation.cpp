@@ -13,6 +13,7 @@
 #include "camera_imu_alignment/inertial/magnetometer.h"
 #include "camera_imu_alignment/inertial/stationary_detector.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
+#include "synthetic_imu.h"
 
 namespace camera_imu_alignment {
 namespace {
@@ -200,6 +201,123 @@ TEST(StationaryDetector, GapEndsTheRestAndBadSamplesAreIgnored) {
   for (const auto& s : segments) EXPECT_TRUE(s.mean_accel_m_s2.allFinite());
 }
 
+TEST(StationaryDetector, FindsEveryRestOfANoisyUnitWithA5DegPerSecondBiasTakenFromTheRest) {
+  // Twelve poses held 3-5 s, joined by minimum-jerk moves of 2-3 s (20-120 deg about random axes,
+  // about 0.2 m): every rest found once, none reported while moving, each with its own bias. The
+  // first rest has no previous bias to go by.
+  for (std::uint32_t seed : {21u, 22u, 23u}) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    std::normal_distribution<double> normal(0.0, 1.0);
+    test::SyntheticImu imu(test::noisyBiasedUnit(), randomRotation(rng), seed);
+    for (int pose = 0; pose < 12; ++pose) {
+      imu.rest(3.0 + 2.0 * uniform(rng));
+      if (pose == 11) break;
+      const Eigen::Vector3d axis =
+          Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+      const Eigen::Vector3d displacement(0.2 * normal(rng), 0.2 * normal(rng), 0.1 * normal(rng));
+      imu.move(deg2rad(20.0 + 100.0 * uniform(rng)) * axis, displacement, 2.0 + uniform(rng));
+    }
+    const auto segments = detectStationarySegments(imu.samples());
+    const test::RestMatch m = test::matchRests(imu, segments);
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    EXPECT_EQ(m.rests_found_once, 12);
+    EXPECT_EQ(m.stray_segments, 0);
+    EXPECT_GE(m.recall, 0.95);
+    EXPECT_EQ(m.moving_detected_s, 0.0);
+    ASSERT_FALSE(segments.empty());
+    EXPECT_LE(segments[0].start_s, 0.5 + 0.01);  // the first rest from its first full window
+    const double noise_rms = std::sqrt(3.0) * imu.unit().gyro_sigma_rad_s;
+    for (const auto& s : segments) {
+      // Mean of >= 400 samples: 0.003 rad/s per axis.
+      EXPECT_LT((s.gyro_bias_rad_s - imu.unit().gyro_bias_rad_s).norm(), 0.015) << s.start_s;
+      EXPECT_NEAR(s.gyro_std_rad_s, noise_rms, 0.1 * noise_rms) << s.start_s;
+    }
+  }
+}
+
+TEST(StationaryDetector, NoRestDuringSlowConstantRotations) {
+  // A constant rotation has the gyro mean and scatter of a rest. Across gravity it turns the
+  // accelerometer; about gravity only the previous rest's bias tells it apart.
+  const Eigen::Vector3d axes[] = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
+                                  Eigen::Vector3d::UnitZ(), Eigen::Vector3d(1, 1, 1)};
+  std::uint32_t seed = 30;
+  for (const Eigen::Vector3d& axis : axes) {
+    for (double rate_deg_s : {3.0, 6.0, 12.0}) {
+      SCOPED_TRACE("axis " + std::to_string(axis.x()) + " " + std::to_string(axis.y()) + " " +
+                   std::to_string(axis.z()) + ", " + std::to_string(rate_deg_s) + " deg/s");
+      std::mt19937 rng(++seed);
+      test::SyntheticImu imu(test::noisyBiasedUnit(), randomRotation(rng), seed);
+      imu.rest(4.0);
+      imu.spin(axis, deg2rad(rate_deg_s), 1.0, 8.0, 1.0);
+      imu.rest(4.0);
+      const auto segments = detectStationarySegments(imu.samples());
+      const test::RestMatch m = test::matchRests(imu, segments);
+      EXPECT_EQ(m.spinning_detected_s, 0.0);
+      EXPECT_EQ(m.rests_found_once, 2);
+      // Only the two rests; their ends may reach into the 1-s ramps, where the rate (< 2 deg/s)
+      // is within this gyro's noise.
+      EXPECT_EQ(segments.size(), 2u);
+    }
+  }
+  // Spinning from the start, no bias known yet: the accelerometer alone refuses rotations with
+  // more than 1.5 deg/s across gravity for this accelerometer (1 deg/s for a quiet one); here 3
+  // deg/s about axes 55 degrees or more from it.
+  for (const Eigen::Vector3d& axis : {axes[0], axes[1], axes[3]}) {
+    for (double rate_deg_s : {3.0, 6.0}) {
+      std::mt19937 rng(++seed);
+      test::SyntheticImu imu(test::noisyBiasedUnit(), randomRotation(rng), seed);
+      imu.spin(axis, deg2rad(rate_deg_s), 0.0, 8.0, 1.0);
+      imu.rest(4.0);
+      const test::RestMatch m = test::matchRests(imu, detectStationarySegments(imu.samples()));
+      EXPECT_EQ(m.spinning_detected_s, 0.0) << rate_deg_s << " deg/s";
+      EXPECT_EQ(m.rests_found_once, 1) << rate_deg_s << " deg/s";
+    }
+  }
+}
+
+TEST(StationaryDetector, ThePreviousBiasIsAHintNotARequirement) {
+  // The bias steps by 0.05 rad/s about gravity and 0.09 across it between two rests (a warm-up):
+  // the accelerometer shows the rest still, and a rotation more than twice its turn-rate limit
+  // across gravity (0.05 rad/s for this accelerometer) would have turned it: the step is the
+  // bias's, and the rest is taken.
+  test::ImuUnit unit = test::noisyBiasedUnit();
+  unit.gyro_bias_rad_s = Eigen::Vector3d(0.01, -0.02, 0.01);  // within the old first-rest limit
+  const Eigen::Matrix3d R_world_imu = Eigen::Matrix3d::Identity();  // up = IMU z
+  {
+    test::SyntheticImu imu(unit, R_world_imu, 40);
+    imu.rest(4.0);
+    imu.move(deg2rad(90.0) * Eigen::Vector3d::UnitY(), Eigen::Vector3d::Zero(), 2.0);
+    // IMU -x is now up.
+    imu.unit().gyro_bias_rad_s += Eigen::Vector3d(0.05, 0.09, 0.0);
+    imu.rest(4.0);
+    const auto segments = detectStationarySegments(imu.samples());
+    const test::RestMatch m = test::matchRests(imu, segments);
+    EXPECT_EQ(m.rests_found_once, 2);
+    EXPECT_EQ(segments.size(), 2u);
+    if (segments.size() == 2u) {
+      EXPECT_LT((segments[1].gyro_bias_rad_s - imu.unit().gyro_bias_rad_s).norm(), 0.015);
+    }
+  }
+  {
+    // A step about gravity only, the next rests at the same tilt (turns about the vertical): the
+    // first rest after it looks like a rotation about gravity and is lost, but a wrong hint does
+    // not refuse every later rest.
+    test::SyntheticImu imu(unit, R_world_imu, 41);
+    imu.rest(4.0);
+    imu.move(deg2rad(60.0) * Eigen::Vector3d::UnitZ(), Eigen::Vector3d(0.2, 0, 0), 2.0);
+    imu.unit().gyro_bias_rad_s.z() += 0.05;
+    for (int k = 0; k < 3; ++k) {
+      imu.rest(4.0);
+      imu.move(deg2rad(-40.0) * Eigen::Vector3d::UnitZ(), Eigen::Vector3d(0, 0.2, 0), 2.0);
+    }
+    imu.rest(4.0);
+    const test::RestMatch m = test::matchRests(imu, detectStationarySegments(imu.samples()));
+    EXPECT_GE(m.rests_found_once, 4);  // of 5
+    EXPECT_EQ(m.stray_segments, 0);
+  }
+}
+
 // ------------------------------------------------------------------------------------------
 // Magnetometer hygiene
 // ------------------------------------------------------------------------------------------
@@ -311,7 +429,7 @@ TEST_P(Broad, DetectorAgreesWithTheAuthorsLabelsAndAttitudeWithTheReference) {
   RecordProperty("precision", std::to_string(score.precision));
   RecordProperty("recall", std::to_string(score.recall));
   EXPECT_GE(score.precision, 0.99);
-  EXPECT_GE(score.recall, 0.95);
+  EXPECT_GE(score.recall, 0.97);
 
   // Attitude at each rest against the motion-capture reference. Their heading origins differ by a
   // constant (magnetic north vs. the capture room), so compare rotations between rests, and the

@@ -72,10 +72,12 @@ std::string PipelineSettings::validate() const {
   const std::pair<const char*, double> positives[] = {
       {"stationary_window_s", stationary.window_s},
       {"min_stationary_duration_s", stationary.min_duration_s},
-      {"max_gyro_norm_rad_s", stationary.max_gyro_rad_s},
-      {"max_initial_gyro_bias_rad_s", stationary.max_initial_gyro_bias_rad_s},
       {"max_gyro_std_rad_s", stationary.max_gyro_std_rad_s},
       {"max_accel_std_m_s2", stationary.max_accel_std_m_s2},
+      {"max_gyro_change_rad_s", stationary.max_gyro_change_rad_s},
+      {"max_gravity_turn_rate_rad_s", stationary.max_gravity_turn_rate_rad_s},
+      {"max_gyro_bias_rad_s", stationary.max_gyro_bias_rad_s},
+      {"max_rate_about_gravity_rad_s", stationary.max_rate_about_gravity_rad_s},
       {"max_gravity_error_m_s2", stationary.max_gravity_error_m_s2},
       {"gravity_m_s2", stationary.gravity_m_s2},
       {"max_imu_gap_s", stationary.max_gap_s},
@@ -104,6 +106,10 @@ std::string PipelineSettings::validate() const {
     out << "min_target_points = " << detector.min_points << ": must be >= 4";
   } else if (!(stationary.noise_factor >= 0.0 && std::isfinite(stationary.noise_factor))) {
     out << "stationary_noise_factor = " << stationary.noise_factor << ": must be >= 0";
+  } else if (!(stationary.change_noise_factor >= 0.0 &&
+               std::isfinite(stationary.change_noise_factor))) {
+    out << "stationary_change_noise_factor = " << stationary.change_noise_factor
+        << ": must be >= 0";
   } else if (!(frame_margin_s >= 0.0 && std::isfinite(frame_margin_s))) {
     out << "frame_margin_s = " << frame_margin_s << ": must be >= 0";
   } else if (!(min_frame_interval_s >= 0.0 && std::isfinite(min_frame_interval_s))) {
