@@ -39,8 +39,9 @@ std::string validateSettings(const JointSettings& s) {
   }
   if (!finitePositive(s.gravity_m_s2)) return "settings: gravity_m_s2 must be finite and > 0";
   if (!finitePositive(s.robust_loss_scale)) return "settings: robust_loss_scale must be > 0";
-  if (s.max_iterations < 1 || s.max_relinearisations < 1) {
-    return "settings: max_iterations and max_relinearisations must be >= 1";
+  if (!finitePositive(s.max_std_dev_deg)) return "settings: max_std_dev_deg must be > 0";
+  if (s.max_iterations < 1 || s.max_relinearisations < 2) {
+    return "settings: max_iterations must be >= 1 and max_relinearisations >= 2";
   }
   for (double t :
        {s.min_gyro_axis_rotation_deg, s.min_gravity_coverage_bias, s.min_gravity_spread_matrix,
@@ -236,6 +237,13 @@ void State::foldRotationIncrements() {
       projectToSO3(expSO3(Eigen::Vector3d(e_T[0], e_T[1], e_T[2])) * R_world_target_0);
   e_X = {0.0, 0.0, 0.0};
   e_T = {0.0, 0.0, 0.0};
+}
+
+void State::holdUnexcitedGyroColumns(const JointObservability& observability) {
+  for (int c = 0; c < 3; ++c) {
+    if (observability.gyro_column_estimated[c]) continue;
+    for (int r = 0; r < 3; ++r) gyro_matrix[3 * r + c] = 0.0;
+  }
 }
 
 }  // namespace joint
