@@ -311,6 +311,11 @@ TEST(JointEstimator, BadInputIsRefusedWithAMessageAndNoNaN) {
          p.segments[2].stamps_s.clear();
          p.segments[2].gyro_rad_s.clear();
        }},
+      {"samples lost within a motion", "a gap of",
+       [](JointProblem& p, Eigen::Matrix3d&, JointSettings&) {
+         for (size_t i = 200; i < p.segments[1].stamps_s.size(); ++i)
+           p.segments[1].stamps_s[i] += 0.5;
+       }},
       {"stamps and samples differ", "differ in length",
        [](JointProblem& p, Eigen::Matrix3d&, JointSettings&) {
          p.segments[2].stamps_s.pop_back();

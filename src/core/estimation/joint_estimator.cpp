@@ -127,7 +127,7 @@ JointResult JointEstimator::solve(const JointProblem& problem,
   }
 
   const ceres::Solver::Options options = solverOptions(settings_);
-  bool converged = false;
+  bool converged = false, gyro_settled = true;
   for (int pass = 0; pass < settings_.max_relinearisations; ++pass) {
     if (pass > 0) {
       const Eigen::Matrix3d T_g = state.gyroMatrix();
@@ -156,8 +156,8 @@ JointResult JointEstimator::solve(const JointProblem& problem,
     converged = solver_summary.termination_type == ceres::CONVERGENCE;
     // With gyro segments at least two passes: the second one judges the gyro's excitation.
     const bool judged = problem.segments.empty() || pass >= 1;
-    const bool last = pass + 1 == settings_.max_relinearisations ||
-                      (judged && gyroModelChange(problem, state, gyro) < kRelinearisationThreshold);
+    gyro_settled = gyroModelChange(problem, state, gyro) < kRelinearisationThreshold;
+    const bool last = pass + 1 == settings_.max_relinearisations || (judged && gyro_settled);
     if (last) {
       if (!joint::fillResult(problem, state, built, observability, settings_, &ceres_problem,
                              &result)) {
@@ -190,6 +190,11 @@ JointResult JointEstimator::solve(const JointProblem& problem,
   if (!converged) {
     result.notes.push_back("the solver stopped before converging (max_iterations " +
                            std::to_string(settings_.max_iterations) + ")");
+  }
+  if (!gyro_settled) {
+    result.notes.push_back("the gyro model still moved in the last of " +
+                           std::to_string(settings_.max_relinearisations) +
+                           " preintegration passes (max_relinearisations)");
   }
   if (result.covariance_scale > 1.0) {
     char buffer[128];

@@ -1,5 +1,6 @@
 // Input checks and measurement whitening of the joint estimator.
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <utility>
@@ -116,6 +117,15 @@ std::string validateSegment(const GyroSegment& segment, size_t j, const JointPro
   }
   if (segment.stamps_s.back() - segment.stamps_s.front() > 3600.0) {
     return name + ": longer than an hour";
+  }
+  // A sample holds until the next one: a gap (lost samples) would stretch one rate over it.
+  const std::vector<double> dt = sampleIntervals(segment.stamps_s);
+  const double longest_allowed = std::max(0.1, 10.0 * dt.back());  // dt.back(): the median
+  for (size_t i = 0; i + 1 < dt.size(); ++i) {
+    if (dt[i] > longest_allowed) {
+      return name + ": a gap of " + std::to_string(dt[i]) + " s after sample " + std::to_string(i) +
+             " (samples are " + std::to_string(dt.back()) + " s apart)";
+    }
   }
   if (!std::isfinite(segment.noise_density_rad_s_sqrt_hz) ||
       segment.noise_density_rad_s_sqrt_hz < 0.0) {
