@@ -95,7 +95,13 @@ JointSimulation simulateJointProblem(const JointSimulationOptions& o, uint64_t s
   std::vector<Eigen::Vector3d> motion_rotvec(n, Eigen::Vector3d::Zero());  // into pose k + 1
   sim.R_world_imu.resize(n);
   sim.R_world_imu[0] = random.rotation();
+  if (o.initial_R_world_imu) sim.R_world_imu[0] = *o.initial_R_world_imu;
   for (int k = 1; k < n; ++k) {
+    if (static_cast<int>(o.motions_imu_rad.size()) == n - 1) {
+      motion_rotvec[k - 1] = o.motions_imu_rad[k - 1];
+      sim.R_world_imu[k] = sim.R_world_imu[k - 1] * expSO3(motion_rotvec[k - 1]);
+      continue;
+    }
     Eigen::Vector3d axis = random.unitVector();
     if (o.rotation_axis_imu) axis = o.rotation_axis_imu->normalized();
     if (o.vertical_rotations_only) axis = sim.R_world_imu[k - 1].transpose().col(2);

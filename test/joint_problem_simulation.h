@@ -27,6 +27,10 @@ struct JointSimulationOptions {
   double min_rotation_deg = 20.0, max_rotation_deg = 90.0;
   std::optional<Eigen::Vector3d> rotation_axis_imu;  ///< all motions about this IMU axis
   bool vertical_rotations_only = false;  ///< all motions about the vertical (gravity unchanged)
+  /// Explicit motions (rotation vectors, IMU frame, rad), one per motion (num_poses - 1); they
+  /// replace the random ones when given.
+  std::vector<Eigen::Vector3d> motions_imu_rad;
+  std::optional<Eigen::Matrix3d> initial_R_world_imu;  ///< the first pose (random when empty)
   double rest_s = 3.0, motion_s = 2.0, rate_hz = 200.0;
 
   bool noise = true;  ///< false: exact measurements (the stated covariances stay as below)

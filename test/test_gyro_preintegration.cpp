@@ -67,8 +67,6 @@ TEST(GyroPreintegration, ConstantRateGivesTheExponential) {
   const GyroPreintegration p = preintegrateGyro(stamps, gyro, 5.0, 7.0, T_g, bias, bias);
   EXPECT_NEAR(p.duration_s, 2.0, 1e-12);
   EXPECT_LT(geodesicDistance(p.delta_R, expSO3(true_rate * 2.0)), 1e-12);
-  EXPECT_NEAR(p.excitation_rad.trace(), true_rate.norm() * 2.0, 1e-9);
-  EXPECT_NEAR(p.accumulated_abs_angle_rad(2), 1.3 * 2.0, 1e-9);
 }
 
 TEST(GyroPreintegration, MatchesAPlainQuaternionIntegrationWithABiasRamp) {

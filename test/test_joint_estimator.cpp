@@ -1,58 +1,35 @@
 // The joint maximum-likelihood estimator (estimation/joint_estimator.h) on problems generated from
 // a known truth (joint_problem_simulation.h): exact without noise, accurate and consistent with
-// noise for two IMU grades, parameters held when the motion does not excite them, the degenerate
-// shapes of input (3 poses, no magnetometer, no gyro, several groups) and bad input.
+// noise for two IMU grades, robust to a bad camera pose, honest when the stated noise is too small.
+// Degenerate shapes of input and bad input: test_joint_estimator_cases.cpp.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 
 #include "camera_imu_alignment/estimation/joint_estimator.h"
-#include "camera_imu_alignment/estimation/joint_observability.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "joint_problem_simulation.h"
+#include "joint_test_helpers.h"
 
 namespace camera_imu_alignment {
 namespace {
 
+using test::allNotes;
+using test::errorDeg;
+using test::expectFinite;
+using test::fractionWithin;
+using test::hasNote;
 using test::JointSimulation;
 using test::JointSimulationOptions;
+using test::maxNormalisedError;
+using test::motionsAboutZ;
 using test::perturbedRotation;
+using test::rms;
 using test::rotationError;
 using test::simulateJointProblem;
-
-double errorDeg(const JointResult& result, const JointSimulation& sim) {
-  return rad2deg(rotationError(result.R_cam_imu, sim.R_cam_imu).norm());
-}
-
-bool hasNote(const JointResult& result, const std::string& text) {
-  for (const std::string& note : result.notes) {
-    if (note.find(text) != std::string::npos) return true;
-  }
-  return false;
-}
-
-std::string allNotes(const JointResult& result) {
-  std::string out;
-  for (const std::string& note : result.notes) out += "\n  " + note;
-  return out;
-}
-
-/// Every number of the result is finite (a failed solve included).
-void expectFinite(const JointResult& r) {
-  EXPECT_TRUE(r.R_cam_imu.allFinite());
-  EXPECT_TRUE(r.covariance_rad2.allFinite());
-  EXPECT_TRUE(r.std_dev_deg.allFinite());
-  EXPECT_TRUE(std::isfinite(r.chi2));
-  EXPECT_TRUE(std::isfinite(r.chi2_p_value));
-  EXPECT_TRUE(r.suggested_rotation_axis_imu.allFinite());
-  for (double v : r.pose_residual_norm) EXPECT_TRUE(std::isfinite(v));
-  EXPECT_TRUE(r.intrinsics.gyro_matrix.allFinite());
-  EXPECT_TRUE(r.intrinsics.accel_matrix.allFinite());
-  EXPECT_TRUE(r.intrinsics.hard_iron_t.allFinite());
-}
+using test::solveSimulation;
 
 TEST(JointEstimator, NoiseFreeExactRecovery) {
   // Exact measurements; the stated noise and the priors are realistic except that the priors on
@@ -159,18 +136,6 @@ GradeStatistics runGrade(const JointSimulationOptions& options, const JointSetti
   return stats;
 }
 
-double rms(const std::vector<double>& v) {
-  double sum = 0.0;
-  for (double x : v) sum += x * x;
-  return v.empty() ? 0.0 : std::sqrt(sum / v.size());
-}
-
-double fractionWithin(const std::vector<double>& v, double bound) {
-  const auto inside =
-      std::count_if(v.begin(), v.end(), [&](double x) { return std::abs(x) <= bound; });
-  return v.empty() ? 0.0 : static_cast<double>(inside) / v.size();
-}
-
 void expectConsistent(const GradeStatistics& stats, const std::string& grade) {
   const double normalised_std = rms(stats.normalised);
   std::printf(
@@ -215,6 +180,86 @@ TEST(JointEstimator, NoisyGyroGradeConsistent) {
   const GradeStatistics stats = runGrade(options, settings, 30, 200);
   expectConsistent(stats, "noisy");
   EXPECT_LE(rms(stats.error_deg), 0.1);
+}
+
+TEST(JointEstimator, RobustLossLimitsABadCameraPose) {
+  const JointSimulation clean = simulateJointProblem(JointSimulationOptions{}, 100);
+  JointSimulation sim = clean;
+  sim.problem.poses[5].R_target_cam =
+      sim.problem.poses[5].R_target_cam * expSO3(deg2rad(2.0) * Eigen::Vector3d(0.6, 0.0, 0.8));
+  const JointResult huber = solveSimulation(sim);
+  JointSettings plain;
+  plain.robust_loss = RobustLossKind::kNone;
+  const JointResult least_squares = solveSimulation(sim, plain);
+  JointSettings cauchy;
+  cauchy.robust_loss = RobustLossKind::kCauchy;
+  const JointResult cauchy_result = solveSimulation(sim, cauchy);
+  ASSERT_TRUE(huber.ok && least_squares.ok && cauchy_result.ok);
+  std::printf(
+      "2 deg camera outlier: error %.4f deg (Huber), %.4f (Cauchy), %.4f (none), clean "
+      "%.4f\n",
+      errorDeg(huber, sim), errorDeg(cauchy_result, sim), errorDeg(least_squares, sim),
+      errorDeg(solveSimulation(clean), clean));
+  EXPECT_LT(errorDeg(huber, sim), errorDeg(least_squares, sim));
+  EXPECT_LT(errorDeg(cauchy_result, sim), errorDeg(least_squares, sim));
+  EXPECT_LT(errorDeg(huber, sim), 0.1);
+  // The bad pose stands out in the per-pose residuals.
+  const auto worst =
+      std::max_element(huber.pose_residual_norm.begin(), huber.pose_residual_norm.end());
+  EXPECT_EQ(worst - huber.pose_residual_norm.begin(), 5);
+  EXPECT_GT(*worst, 3.0);
+}
+
+TEST(JointEstimator, UnderstatedNoiseScalesTheCovariance) {
+  // The data's noise is 3x the stated one: chi2 / dof ~ 9 and the covariance is scaled by it.
+  JointSimulationOptions options;
+  options.camera_sigma_rad *= 3.0;
+  options.accel_noise_m_s2 *= 3.0;
+  options.gyro_noise_density *= 3.0;
+  options.mag_noise_t *= 3.0;
+  JointSimulation sim = simulateJointProblem(options, 110);
+  for (JointPose& pose : sim.problem.poses) {
+    pose.cov_cam_rad2 /= 9.0;
+    pose.accel_mean_cov /= 9.0;
+    pose.gyro_mean_cov /= 9.0;
+    pose.mag_mean_cov /= 9.0;
+  }
+  for (GyroSegment& segment : sim.problem.segments) segment.noise_density_rad_s_sqrt_hz /= 3.0;
+  const JointResult r = solveSimulation(sim);
+  ASSERT_TRUE(r.ok) << r.message;
+  EXPECT_GT(r.covariance_scale, 3.0);
+  EXPECT_LT(r.chi2_p_value, 1e-6);
+  EXPECT_TRUE(hasNote(r, "covariances scaled by chi2/dof")) << allNotes(r);
+  EXPECT_LT(maxNormalisedError(r, sim), 3.5);
+}
+
+TEST(JointEstimator, SameAnswerFromAFarInitialGuess) {
+  const JointSimulation sim = simulateJointProblem(JointSimulationOptions{}, 120);
+  const JointResult near = solveSimulation(sim, {}, 0.5, 1);
+  const JointResult far = solveSimulation(sim, {}, 10.0, 2);
+  ASSERT_TRUE(near.ok && far.ok);
+  EXPECT_LT(rad2deg(geodesicDistance(near.R_cam_imu, far.R_cam_imu)), 1e-5);
+  EXPECT_LT(errorDeg(far, sim), 0.1);
+}
+
+TEST(JointEstimator, SymmetricAccelerometerMatrixExact) {
+  JointSimulationOptions options;
+  options.noise = false;
+  options.with_magnetometer = false;
+  options.accel_matrix_form = AccelMatrixForm::kSymmetric;
+  const JointSimulation sim = simulateJointProblem(options, 130);
+  JointSettings settings;
+  settings.accel_matrix_form = AccelMatrixForm::kSymmetric;
+  settings.priors.accel_scale *= 1000.0;
+  settings.priors.accel_cross_axis *= 1000.0;
+  settings.priors.accel_bias_m_s2 *= 1000.0;
+  settings.priors.gyro_scale *= 1000.0;
+  settings.priors.gyro_cross_axis *= 1000.0;
+  const JointResult r = solveSimulation(sim, settings, 2.0);
+  ASSERT_TRUE(r.ok) << r.message;
+  EXPECT_LT(errorDeg(r, sim), 1e-6);
+  EXPECT_LT((r.intrinsics.accel_matrix - sim.T_a).cwiseAbs().maxCoeff(), 1e-8);
+  EXPECT_LT((r.intrinsics.accel_matrix - r.intrinsics.accel_matrix.transpose()).norm(), 1e-15);
 }
 
 }  // namespace

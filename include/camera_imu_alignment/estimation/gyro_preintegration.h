@@ -26,10 +26,6 @@ struct GyroPreintegration {
   GyroPreintegrationJacobian jacobian = GyroPreintegrationJacobian::Zero();
   GyroModelVector theta0 = GyroModelVector::Zero();  ///< linearisation point
   double duration_s = 0;                             ///< sum of the samples' intervals (s)
-  /// Excitation of the motion (IMU frame, from T_g^-1 (w - b)): sum_i |w_i| dt_i per axis (rad) and
-  /// sum_i w_i w_i^T / |w_i| dt_i (rad; its trace is the total rotation angle).
-  Eigen::Vector3d accumulated_abs_angle_rad = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d excitation_rad = Eigen::Matrix3d::Zero();
 };
 
 /// theta from its parts.

@@ -25,12 +25,12 @@ double directionCoverage(const std::vector<Eigen::Vector3d>& unit_directions,
 double directionSpread(const std::vector<Eigen::Vector3d>& unit_directions,
                        Eigen::Vector3d* least_spread_direction = nullptr);
 
-/// What the motions excite, summed over all gyro segments (IMU frame, from the bias-corrected
-/// gyro).
+/// What the motions excite, summed over the gyro segments' net rotations phi = Log(DeltaR) (IMU
+/// frame, from the bias-corrected gyro; net rather than sum |w| dt, which would add up the noise).
 struct GyroExcitation {
   bool has_segments = false;
-  Eigen::Vector3d accumulated_abs_angle_rad = Eigen::Vector3d::Zero();  ///< sum |w_j| dt per axis
-  Eigen::Matrix3d excitation_rad = Eigen::Matrix3d::Zero();             ///< sum w w^T / |w| dt
+  Eigen::Vector3d accumulated_abs_angle_rad = Eigen::Vector3d::Zero();  ///< sum |phi_j| per axis
+  Eigen::Matrix3d excitation_rad = Eigen::Matrix3d::Zero();             ///< sum phi phi^T / |phi|
 };
 
 struct JointObservability {

@@ -86,9 +86,12 @@ struct JointSettings {
   RobustLossKind robust_loss = RobustLossKind::kHuber;
   double robust_loss_scale = 4.0;
   int max_iterations = 50;       ///< Levenberg-Marquardt iterations per solve
-  int max_relinearisations = 5;  ///< gyro re-preintegrations (outer passes)
+  int max_relinearisations = 5;  ///< gyro preintegration passes (outer loop), >= 2
   MagnetometerUse use_magnetometer = MagnetometerUse::kAuto;
   double gravity_m_s2 = 9.81;
+  /// The estimate is refused (ok = false) when its 1-sigma about a camera axis exceeds this (deg):
+  /// the poses do not determine R_cam_imu (e.g. no rotation between them).
+  double max_std_dev_deg = 10.0;
 
   // Observability: what the poses do not excite is not estimated (estimated = false, a note). By
   // default such a parameter keeps its prior as a constraint (it stays at its prior mean unless the

@@ -93,10 +93,6 @@ GyroPreintegration preintegrateGyro(const std::vector<double>& stamps_s,
     J.block<3, 3>(0, 9) += (1.0 - s) * M;
     J.block<3, 3>(0, 12) += s * M;
     delta_R = delta_R * step_R;
-
-    const double speed = rate.norm();
-    result.accumulated_abs_angle_rad += rate.cwiseAbs() * dt[i];
-    if (speed > 0.0) result.excitation_rad += (rate * rate.transpose()) * (dt[i] / speed);
     result.duration_s += dt[i];
   }
   result.delta_R = projectToSO3(delta_R);

@@ -19,8 +19,9 @@ namespace camera_imu_alignment {
 namespace {
 
 /// The gyro linearisation is redone until the gyro model moves less than this between passes
-/// (T_g entries, rad/s for the biases): the first-order preintegration error is then ~1e-12 rad.
-constexpr double kRelinearisationThreshold = 1e-6;
+/// (T_g entries, rad/s for the biases): the first-order preintegration error, ~change^2 x the
+/// rotation angle, is then ~1e-10 rad.
+constexpr double kRelinearisationThreshold = 1e-5;
 
 std::vector<GyroPreintegration> preintegrateAll(const JointProblem& problem,
                                                 const Eigen::Matrix3d& T_g,
@@ -40,8 +41,9 @@ GyroExcitation excitationOf(const std::vector<GyroPreintegration>& segments) {
   GyroExcitation excitation;
   excitation.has_segments = !segments.empty();
   for (const GyroPreintegration& segment : segments) {
-    excitation.accumulated_abs_angle_rad += segment.accumulated_abs_angle_rad;
-    excitation.excitation_rad += segment.excitation_rad;
+    const Eigen::Vector3d phi = logSO3(segment.delta_R);
+    excitation.accumulated_abs_angle_rad += phi.cwiseAbs();
+    if (phi.norm() > 0.0) excitation.excitation_rad += phi * phi.transpose() / phi.norm();
   }
   return excitation;
 }
@@ -113,8 +115,11 @@ JointResult JointEstimator::solve(const JointProblem& problem,
   for (size_t k = 0; k < n; ++k) biases[k] = problem.poses[k].gyro_mean_rad_s;
   std::vector<GyroPreintegration> gyro =
       preintegrateAll(problem, Eigen::Matrix3d::Identity(), biases);
-  const JointObservability observability =
-      decideObservability(problem, excitationOf(gyro), settings_);
+  // The gyro's excitation is judged again after the first pass, from the gyro corrected by the
+  // estimated T_g (the raw gyro's cross-axis terms leak ~1 % of every rotation into other axes);
+  // until then no gyro column is pinned.
+  JointObservability observability = decideObservability(problem, excitationOf(gyro), settings_);
+  observability.gyro_column_estimated = {true, true, true};
   joint::State state = joint::initialState(problem, R_cam_imu_initial, observability, settings_);
   joint::Whitening whitening;
   if (!joint::computeWhitening(problem, gyro, settings_, &whitening, &result.message)) {
@@ -122,7 +127,7 @@ JointResult JointEstimator::solve(const JointProblem& problem,
   }
 
   const ceres::Solver::Options options = solverOptions(settings_);
-  bool converged = false;
+  bool converged = false, gyro_settled = true;
   for (int pass = 0; pass < settings_.max_relinearisations; ++pass) {
     if (pass > 0) {
       const Eigen::Matrix3d T_g = state.gyroMatrix();
@@ -132,6 +137,10 @@ JointResult JointEstimator::solve(const JointProblem& problem,
       }
       for (size_t k = 0; k < n; ++k) biases[k] = state.gyroBias(static_cast<int>(k));
       gyro = preintegrateAll(problem, T_g, biases);
+      if (pass == 1) {
+        observability = decideObservability(problem, excitationOf(gyro), settings_);
+        if (settings_.pin_unexcited_parameters) state.holdUnexcitedGyroColumns(observability);
+      }
     }
     ceres::Problem ceres_problem;
     const joint::BuiltProblem built = joint::buildProblem(problem, gyro, whitening, observability,
@@ -145,8 +154,10 @@ JointResult JointEstimator::solve(const JointProblem& problem,
       return finish(result);
     }
     converged = solver_summary.termination_type == ceres::CONVERGENCE;
-    const bool last = pass + 1 == settings_.max_relinearisations ||
-                      gyroModelChange(problem, state, gyro) < kRelinearisationThreshold;
+    // With gyro segments at least two passes: the second one judges the gyro's excitation.
+    const bool judged = problem.segments.empty() || pass >= 1;
+    gyro_settled = gyroModelChange(problem, state, gyro) < kRelinearisationThreshold;
+    const bool last = pass + 1 == settings_.max_relinearisations || (judged && gyro_settled);
     if (last) {
       if (!joint::fillResult(problem, state, built, observability, settings_, &ceres_problem,
                              &result)) {
@@ -166,9 +177,24 @@ JointResult JointEstimator::solve(const JointProblem& problem,
   }
   result.suggested_rotation_axis_imu = observability.suggested_rotation_axis_imu;
   result.notes = observability.notes;
+  if (!(result.std_dev_deg.maxCoeff() <= settings_.max_std_dev_deg)) {
+    char buffer[256];
+    std::snprintf(buffer, sizeof(buffer),
+                  "R_cam_imu is not determined: 1-sigma [%.2f %.2f %.2f] deg > %.2f deg (the "
+                  "poses barely rotate)",
+                  result.std_dev_deg(0), result.std_dev_deg(1), result.std_dev_deg(2),
+                  settings_.max_std_dev_deg);
+    result.message = buffer;
+    return finish(result);
+  }
   if (!converged) {
     result.notes.push_back("the solver stopped before converging (max_iterations " +
                            std::to_string(settings_.max_iterations) + ")");
+  }
+  if (!gyro_settled) {
+    result.notes.push_back("the gyro model still moved in the last of " +
+                           std::to_string(settings_.max_relinearisations) +
+                           " preintegration passes (max_relinearisations)");
   }
   if (result.covariance_scale > 1.0) {
     char buffer[128];

@@ -70,7 +70,7 @@ JointObservability decideObservability(const JointProblem& problem, const GyroEx
   JointObservability out;
   const std::string held = settings.pin_unexcited_parameters
                                ? "held at its prior"
-                               : "held at its prior (its uncertainty kept in the covariances)";
+                               : "held at its prior (with its prior uncertainty)";
 
   // Gyro: column j of T_g multiplies the rate about IMU axis j.
   out.gyro_axis_rotation_deg = gyro.accumulated_abs_angle_rad * (180.0 / kPi);
@@ -114,7 +114,9 @@ JointObservability decideObservability(const JointProblem& problem, const GyroEx
     out.notes.push_back("accelerometer scale and non-orthogonality " + held +
                         format(": gravity direction spread %.3f < %.3f", out.gravity_spread,
                                settings.min_gravity_spread_matrix) +
-                        " (needs 4 or more poses); show gravity along each IMU axis, both ways");
+                        " (needs 4 or more poses whose gravity directions are not in one plane); "
+                        "show gravity along "
+                        "each IMU axis, both ways");
   }
 
   // Magnetometer: enough distinct orientations with a usable field.

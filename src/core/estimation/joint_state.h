@@ -37,6 +37,8 @@ struct State {
   Eigen::Vector3d gyroBias(int pose) const;
   /// Folds e_X and e_T into X0 and T0 (then zero).
   void foldRotationIncrements();
+  /// Puts the columns of T_g that `observability` does not estimate back at their prior (I).
+  void holdUnexcitedGyroColumns(const JointObservability& observability);
 };
 
 /// Whitened measurements of the problem (L^-1 of each covariance plus its floor).

@@ -1,5 +1,6 @@
 // Input checks and measurement whitening of the joint estimator.
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <utility>
@@ -39,8 +40,9 @@ std::string validateSettings(const JointSettings& s) {
   }
   if (!finitePositive(s.gravity_m_s2)) return "settings: gravity_m_s2 must be finite and > 0";
   if (!finitePositive(s.robust_loss_scale)) return "settings: robust_loss_scale must be > 0";
-  if (s.max_iterations < 1 || s.max_relinearisations < 1) {
-    return "settings: max_iterations and max_relinearisations must be >= 1";
+  if (!finitePositive(s.max_std_dev_deg)) return "settings: max_std_dev_deg must be > 0";
+  if (s.max_iterations < 1 || s.max_relinearisations < 2) {
+    return "settings: max_iterations must be >= 1 and max_relinearisations >= 2";
   }
   for (double t :
        {s.min_gyro_axis_rotation_deg, s.min_gravity_coverage_bias, s.min_gravity_spread_matrix,
@@ -115,6 +117,15 @@ std::string validateSegment(const GyroSegment& segment, size_t j, const JointPro
   }
   if (segment.stamps_s.back() - segment.stamps_s.front() > 3600.0) {
     return name + ": longer than an hour";
+  }
+  // A sample holds until the next one: a gap (lost samples) would stretch one rate over it.
+  const std::vector<double> dt = sampleIntervals(segment.stamps_s);
+  const double longest_allowed = std::max(0.1, 10.0 * dt.back());  // dt.back(): the median
+  for (size_t i = 0; i + 1 < dt.size(); ++i) {
+    if (dt[i] > longest_allowed) {
+      return name + ": a gap of " + std::to_string(dt[i]) + " s after sample " + std::to_string(i) +
+             " (samples are " + std::to_string(dt.back()) + " s apart)";
+    }
   }
   if (!std::isfinite(segment.noise_density_rad_s_sqrt_hz) ||
       segment.noise_density_rad_s_sqrt_hz < 0.0) {
@@ -236,6 +247,13 @@ void State::foldRotationIncrements() {
       projectToSO3(expSO3(Eigen::Vector3d(e_T[0], e_T[1], e_T[2])) * R_world_target_0);
   e_X = {0.0, 0.0, 0.0};
   e_T = {0.0, 0.0, 0.0};
+}
+
+void State::holdUnexcitedGyroColumns(const JointObservability& observability) {
+  for (int c = 0; c < 3; ++c) {
+    if (observability.gyro_column_estimated[c]) continue;
+    for (int r = 0; r < 3; ++r) gyro_matrix[3 * r + c] = 0.0;
+  }
 }
 
 }  // namespace joint
