@@ -59,7 +59,9 @@ struct StationaryDetectorSettings {
   // Bias.
   double max_gyro_bias_rad_s = 0.3;            ///< |window mean gyro| at any rest (rad/s)
   double max_rate_about_gravity_rad_s = 0.03;  ///< |(window mean gyro - previous bias) . up|
-  double max_gravity_error_m_s2 = 0.4;         ///< | |mean accel| - gravity_m_s2 |
+  /// | |mean accel| - gravity_m_s2 |: an uncalibrated accelerometer reads g off by its bias and
+  /// scale error (up to about 1 m/s^2 for a consumer unit), so the limit is generous.
+  double max_gravity_error_m_s2 = 1.2;
   double gravity_m_s2 = 9.81;
   double max_gap_s = 0.1;  ///< a larger gap between samples ends the current segment
 };
