@@ -9,16 +9,22 @@
 #include <tf2_msgs/TFMessage.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <map>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "bag_topics.h"
 #include "camera_imu_alignment/io/calibration_report.h"
 #include "camera_imu_alignment/io/default_frames.h"
 #include "camera_imu_alignment/io/input_error.h"
+#include "camera_imu_alignment/io/joint_yaml.h"
 #include "camera_imu_alignment/io/result_yaml.h"
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
 #include "camera_imu_alignment/pipeline/pipeline_config.h"
@@ -40,21 +46,58 @@ const char* kUsage =
     "usage: calibrate_bag --bag FILE.bag --target TARGET.yaml [--config PARAMS.yaml]\n"
     "                     [--imu-topic T] [--mag-topic T] [--image-topic T]\n"
     "                     [--camera-info-topic T] [--method optimal|two_step]\n"
-    "                     [--imu-orientation auto|magnetometer|message] [--output RESULT.yaml]\n"
-    "                     [--report REPORT.png] [--truth TRUTH.yaml] [--quiet]\n"
+    "                     [--imu-orientation joint|auto|magnetometer|message]\n"
+    "                     [--output RESULT.yaml] [--imu-yaml IMU.yaml] [--report REPORT.png]\n"
+    "                     [--truth TRUTH.yaml] [--quiet]\n"
     "  --bag FILE.bag        ROS 1 bag: sensor_msgs/Imu, optional MagneticField, Image or\n"
     "                        CompressedImage and CameraInfo (topics found by type when not given)\n"
     "  --target TARGET.yaml  Kalibr target file (checkerboard, aprilgrid, circlegrid)\n"
     "  --config PARAMS.yaml  settings, keys as in config/default.yaml\n"
     "  --method M            optimal (default) or two_step (the paper's iteration alone)\n"
-    "  --imu-orientation S   auto (default: gyro between poses), magnetometer (the paper's) or\n"
-    "                        message (the Imu message's own orientation)\n"
+    "  --imu-orientation S   joint (default: one estimate from every sensor with the IMU's errors\n"
+    "                        calibrated), or pairs of poses with the IMU orientation from: auto\n"
+    "                        (gyro between poses), magnetometer (the paper's) or message (the Imu\n"
+    "                        message's own orientation)\n"
     "  --output RESULT.yaml  write the result YAML there (see doc/CONVENTIONS.md in the package)\n"
+    "  --imu-yaml IMU.yaml   with the joint estimate: a Kalibr imu.yaml (noise densities measured\n"
+    "                        at the rests) with the calibrated IMU intrinsics added\n"
     "  --report REPORT.png   write a one-page report: residuals, axis coverage, rests, estimate\n"
     "  --truth TRUTH.yaml    a YAML with R_cam_imu (e.g. simulate_bag's) to print the error to\n"
     "  --quiet               no progress on stderr\n"
     "exit codes: 0 success, 2 bad input or usage, 3 not enough information (the message says what\n"
     "motion is missing)\n";
+
+/// --imu-yaml: the Kalibr imu.yaml of the joint estimate. White noise densities from the rests:
+/// the median over the rests of the per-sample scatter times sqrt(sample period).
+bool writeImuYaml(const std::string& path, const cia::ReportInput& report,
+                  const std::string& imu_topic) {
+  if (!report.result.joint || !report.result.joint->ok) {
+    std::cerr << "calibrate_bag: --imu-yaml " << path
+              << ": no joint estimate (--imu-orientation joint) to write\n";
+    return false;
+  }
+  std::vector<double> gyro, accel, rate;
+  for (const cia::StationarySegment& s : report.segments) {
+    if (s.num_samples < 10 || s.duration() <= 0.0) continue;
+    const double dt = s.duration() / (s.num_samples - 1);
+    gyro.push_back(s.gyro_std_rad_s / std::sqrt(3.0) * std::sqrt(dt));
+    accel.push_back(s.accel_norm_std_m_s2 * std::sqrt(dt));
+    rate.push_back(1.0 / dt);
+  }
+  const auto median = [](std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  std::ofstream out(path);
+  out << cia::kalibrImuYaml(*report.result.joint, median(gyro), median(accel), median(rate),
+                            imu_topic);
+  if (!out) {
+    std::cerr << "calibrate_bag: --imu-yaml " << path << ": cannot write the file\n";
+    return false;
+  }
+  return true;
+}
 
 /// Progress on stderr: a live line on a terminal, plain lines every 10% otherwise.
 class Progress {
@@ -322,6 +365,9 @@ int run(const cia::CliArgs& args) {
       return kExitBadInput;
     }
   }
+  if (args.has("--imu-yaml") && !writeImuYaml(args.get("--imu-yaml"), report, topics.imu)) {
+    return kExitBadInput;
+  }
   return kExitOk;
 }
 
@@ -333,7 +379,7 @@ int main(int argc, char** argv) {
       return cia::CliArgs(argc, argv,
                           {"--bag", "--target", "--config", "--imu-topic", "--mag-topic",
                            "--image-topic", "--camera-info-topic", "--method", "--imu-orientation",
-                           "--output", "--report", "--truth"},
+                           "--output", "--imu-yaml", "--report", "--truth"},
                           {"--help", "--quiet"});
     } catch (const cia::UsageError& e) {
       std::cerr << "calibrate_bag: " << e.what() << "\n" << kUsage;
