@@ -180,6 +180,47 @@ TEST(WrapperSettings, BadParametersAreRefusedNamingThem) {
   refused("camera_frme: cam\n", "unknown key 'camera_frme'");
 }
 
+/// The message for `text` (target_file set), or "" when it was accepted.
+std::string refusal(const std::string& text) {
+  WrapperSettings w;
+  PipelineSettings p;
+  try {
+    parseSettings("target_file: t.yaml\n" + text, "params", &w, &p);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Settings, EveryBadValueNamesTheKeyTheAllowedValuesAndTheValueGiven) {
+  // A value of the wrong kind for every key of both tables: one form, "key = value: must be ...".
+  std::vector<std::string> keys = pipelineConfigKeys();
+  keys.insert(keys.end(), wrapperKeys().begin(), wrapperKeys().end());
+  for (const std::string& key : keys) {
+    const std::string message = refusal(key + ": {a: 1}\n");
+    EXPECT_NE(message.find("params: " + key + " = {a: 1}: must be "), std::string::npos) << message;
+    EXPECT_EQ(message.find("bad conversion"), std::string::npos) << message;
+  }
+  // Out of range or the wrong type: the same form with the allowed range, for the cases.
+  const std::pair<std::string, std::string> cases[] = {
+      {"window_poses: -1", "window_poses = -1: must be an integer within [2, 200]"},
+      {"window_poses: 0", "window_poses = 0: must be within [2, 200]"},
+      {"window_poses: 2.5", "window_poses = 2.5: must be an integer within [2, 200]"},
+      {"max_gyro_norm_rad_s: fast", "max_gyro_norm_rad_s = fast: must be a finite number > 0"},
+      {"min_poses: -3", "min_poses = -3: must be an integer >= 2"},
+      {"min_poses: lots", "min_poses = lots: must be an integer >= 2"},
+      {"publish_inverse: maybe", "publish_inverse = maybe: must be true or false"},
+      {"image_transport: theora", "image_transport = theora: must be 'raw' or 'compressed'"},
+      {"solver_method: best", "solver_method = best: must be 'optimal' or 'two_step'"},
+      {"mag_hard_iron_t: [1, 2]", "mag_hard_iron_t = [1, 2]: must be a list of 3 finite numbers"},
+      {"two_step_max_iterations: 0", "two_step_max_iterations = 0: must be an integer >= 1"},
+      {"max_std_dev_deg: 0", "max_std_dev_deg = 0: must be a finite number > 0"}};
+  for (const auto& [text, expected] : cases) {
+    const std::string message = refusal(text + "\n");
+    EXPECT_NE(message.find(expected), std::string::npos) << text << " -> " << message;
+  }
+}
+
 TEST(PipelineConfig, RosOnlyKeysCanBeSkippedAndPartialFilesKeepTheRest) {
   PipelineSettings s;
   parsePipelineConfig("camera_frame: cam\nwindow_poses: 12\n", "params.yaml", &s, {"camera_frame"});
