@@ -161,14 +161,14 @@ bool CalibrationPipeline::Impl::checkStamp(double stamp, double* last, InputStre
   Impl* impl = this;
   if (stamp < *last) {
     std::ostringstream out;
-    out << std::setprecision(15) << "stamp " << stamp << " s is earlier than the previous one ("
-        << *last << " s); sample dropped";
+    out << "stamp " << formatStamp(stamp) << " s is earlier than the previous one ("
+        << formatStamp(*last) << " s); sample dropped";
     impl->reject(RejectReason::kStampBackwards, stream, out.str());
     return false;
   }
   if (stamp == *last) {
     std::ostringstream out;
-    out << std::setprecision(15) << "duplicate stamp " << stamp << " s; sample dropped";
+    out << "duplicate stamp " << formatStamp(stamp) << " s; sample dropped";
     impl->reject(RejectReason::kDuplicateStamp, stream, out.str());
     return false;
   }
@@ -333,7 +333,8 @@ void CalibrationPipeline::Impl::processFrame(const CameraFrame& frame) {
   if (!detector.detect(frame.mono8, &observation, hint)) {
     ++misses_in_a_row;
     std::ostringstream out;
-    out << "image at " << frame.stamp_s << " s (at rest): " << target.describe() << " not found";
+    out << "image at " << formatStamp(frame.stamp_s) << " s (at rest): " << target.describe()
+        << " not found";
     reject(RejectReason::kTargetNotFound, InputStream::kImage, out.str());
     return;
   }
@@ -341,7 +342,7 @@ void CalibrationPipeline::Impl::processFrame(const CameraFrame& frame) {
   const auto pose = estimateCameraPose(observation, target, *intrinsics, settings.pose, &why);
   if (!pose) {
     reject(RejectReason::kPoseRejected, InputStream::kImage,
-           "image at " + std::to_string(frame.stamp_s) + " s: " + why);
+           "image at " + formatStamp(frame.stamp_s) + " s: " + why);
     return;
   }
   misses_in_a_row = 0;
