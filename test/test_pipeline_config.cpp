@@ -2,6 +2,8 @@
 // and equal the built-in defaults. Bad files are refused with the file and key named.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <set>
 
@@ -219,6 +221,42 @@ TEST(Settings, EveryBadValueNamesTheKeyTheAllowedValuesAndTheValueGiven) {
     const std::string message = refusal(text + "\n");
     EXPECT_NE(message.find(expected), std::string::npos) << text << " -> " << message;
   }
+}
+
+TEST(WrapperSettings, TheOutputFileDefaultsToAFileUnderDotRosAndPathsResolveVisibly) {
+  namespace fs = std::filesystem;
+  const std::string home = std::getenv("HOME") ? std::getenv("HOME") : "";
+  ASSERT_FALSE(home.empty());
+  const std::string target = test::processTempDir() + "board.yaml";
+  std::ofstream(target) << "target_type: checkerboard\n";
+  // The default (the documented one, as the launch file passes it) works out of the box.
+  WrapperSettings settings;
+  settings.target_file = target;
+  ASSERT_NO_THROW(resolvePaths(&settings));
+  EXPECT_EQ(settings.output_file, home + "/.ros/camera_imu_alignment.yaml");
+  EXPECT_EQ(settings.target_file, target);
+  // A relative target that is not there: the rule and the absolute path tried.
+  settings.target_file = "no_such_board.yaml";
+  try {
+    resolvePaths(&settings);
+    ADD_FAILURE() << "accepted a missing target";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("target_file 'no_such_board.yaml'"), std::string::npos) << message;
+    EXPECT_NE(message.find("tried " + (fs::current_path() / "no_such_board.yaml").string()),
+              std::string::npos)
+        << message;
+    EXPECT_NE(message.find("~/.ros"), std::string::npos) << message;
+  }
+  // A relative output file is said where it goes.
+  settings.target_file = target;
+  settings.output_file = "result.yaml";
+  const std::vector<std::string> notices = resolvePaths(&settings);
+  ASSERT_EQ(notices.size(), 1u);
+  EXPECT_NE(notices[0].find((fs::current_path() / "result.yaml").string()), std::string::npos)
+      << notices[0];
+  EXPECT_EQ(expandHome("~"), home);
+  EXPECT_EQ(expandHome("~user/x"), "~user/x");  // another user's home: left alone
 }
 
 TEST(PipelineConfig, RosOnlyKeysCanBeSkippedAndPartialFilesKeepTheRest) {

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <sstream>
 
 #include "camera_imu_alignment/io/input_error.h"
@@ -104,6 +106,40 @@ std::string check(const WrapperSettings& s) {
 }
 
 }  // namespace
+
+std::string expandHome(const std::string& path) {
+  if (path.empty() || path[0] != '~' || (path.size() > 1 && path[1] != '/')) return path;
+  const char* home = std::getenv("HOME");
+  return home ? std::string(home) + path.substr(1) : path;
+}
+
+std::vector<std::string> resolvePaths(WrapperSettings* settings) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> notices;
+  const std::string where =
+      "a relative path resolves from the node's working directory (ROS_HOME under roslaunch, "
+      "~/.ros by default), not from where roslaunch was typed";
+  const std::string target = expandHome(settings->target_file);
+  std::error_code error;
+  const fs::path target_abs = fs::absolute(target, error);
+  if (!fs::is_regular_file(target_abs, error)) {
+    const bool relative = fs::path(target).is_relative();
+    throw InputError("target_file '" + settings->target_file + "': no such file: tried " +
+                     target_abs.string() +
+                     (relative ? "; " + where + ": give an absolute path" : ""));
+  }
+  settings->target_file = target_abs.string();
+  if (!settings->output_file.empty()) {
+    const std::string output = expandHome(settings->output_file);
+    const std::string output_abs = fs::absolute(output, error).string();
+    if (fs::path(output).is_relative()) {
+      notices.push_back("output_file '" + settings->output_file + "' is a relative path: " + where +
+                        "; the calibration is written to " + output_abs);
+    }
+    settings->output_file = output_abs;
+  }
+  return notices;
+}
 
 const std::vector<std::string>& wrapperKeys() {
   static const std::vector<std::string> names = keyNames(keys());
