@@ -18,7 +18,8 @@ CIA_PACKAGES=(
   libeigen3-dev libceres-dev libopencv-dev libopencv-contrib-dev libyaml-cpp-dev libgtest-dev libbenchmark-dev
   librosbag-dev libsensor-msgs-dev libstd-msgs-dev libgeometry-msgs-dev libstd-srvs-dev
   libnodelet-dev libimage-transport-dev libtf2-dev libtf2-msgs-dev libtf2-ros-dev
-  libdiagnostic-updater-dev libdiagnostic-msgs-dev tf2-tools
+  libdiagnostic-updater-dev libdiagnostic-msgs-dev tf2-tools libcv-bridge-dev libtf2-eigen-dev
+  python3-std-srvs python3-diagnostic-msgs
   catkin-lint clang-format
 )
 

@@ -10,6 +10,7 @@
 #include <nodelet/NodeletList.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/MagneticField.h>
@@ -28,6 +29,7 @@
 #include <limits>
 #include <map>
 #include <mutex>
+#include <opencv2/imgcodecs.hpp>
 #include <optional>
 #include <tuple>
 
@@ -356,6 +358,123 @@ TEST_F(AlignmentRos, ManualCaptureTakesOnlyTheArmedRest) {
       15.0, [](const AlignmentStatus& s) { return s.poses_total >= 1; }, "/manual");
   ASSERT_TRUE(last) << manual.log();
   EXPECT_EQ(last->poses_total, 1u) << manual.log();
+  // The later rests were not armed: said so, not "no camera data".
+  EXPECT_NE(manual.log().find("not used: not armed"), std::string::npos) << manual.log();
+  EXPECT_EQ(manual.log().find("no camera data"), std::string::npos) << manual.log();
+}
+
+TEST_F(AlignmentRos, AnInstanceThatCannotStartSaysWhyAndItsStartFails) {
+  // A bad value and a relative target path. The node exits 2 printing the reason; the nodelet
+  // logs it under its own name and its load fails, so `nodelet load` exits with an error (before,
+  // it stayed loaded as an empty shell and the loader never returned).
+  const std::string target = " _target_file:=" + std::string(TARGET_YAML);
+  const std::pair<std::string, std::vector<std::string>> cases[] = {
+      {target + " _window_poses:=-1", {"window_poses = -1: must be an integer within [2, 200]"}},
+      {" _target_file:=no_such_board.yaml",
+       {"target_file 'no_such_board.yaml': no such file: tried /", "/no_such_board.yaml",
+        "~/.ros"}}};
+  int n = 0;
+  for (const auto& [arguments, expected] : cases) {
+    const std::string name = "cannot_start_" + std::to_string(n++);
+    std::string log;
+    if (g_instance_kind == "node") {
+      const test::ToolRun run =
+          test::runTool(std::string(ALIGNMENT_NODE_EXE) + " __name:=" + name + arguments, 60);
+      EXPECT_EQ(run.exit_code, 2) << run.out << run.err;
+      log = run.out + run.err;
+    } else {
+      const std::string manager = name + "_manager", manager_log = temp(manager + ".log");
+      std::system(("rosrun nodelet nodelet manager __name:=" + manager + " >" + manager_log +
+                   " 2>&1 & echo $! >" + temp(manager + ".pid"))
+                      .c_str());
+      ASSERT_TRUE(ros::service::waitForService("/" + manager + "/list", ros::Duration(30.0)));
+      const test::ToolRun load =
+          test::runTool("rosrun nodelet nodelet load camera_imu_alignment/AlignmentNodelet " +
+                            manager + " __name:=" + name + arguments,
+                        60);
+      EXPECT_NE(load.exit_code, 0) << "the load did not fail";
+      EXPECT_NE(load.exit_code, 124) << "the loader kept waiting on a nodelet that did not start";
+      nodelet::NodeletList list;
+      ASSERT_TRUE(ros::service::call("/" + manager + "/list", list));
+      EXPECT_TRUE(list.response.nodelets.empty()) << "an empty shell stayed loaded";
+      std::system(("kill $(cat " + temp(manager + ".pid") + ")").c_str());
+      log = test::readTextFile(manager_log) + load.out + load.err;
+    }
+    EXPECT_NE(log.find("/" + name + ": cannot start: "), std::string::npos) << log;
+    for (const std::string& text : expected) {
+      EXPECT_NE(log.find(text), std::string::npos) << text << "\n" << log;
+    }
+    EXPECT_FALSE(ros::service::exists("/" + name + "/calibrate", false));
+  }
+}
+
+TEST_F(AlignmentRos, TheLaunchFileClearsParametersLeftByAnEarlierRun) {
+  // An earlier run left a typo key on the parameter server; alignment.launch (the kind under
+  // test) starts all the same, and the stale key is gone.
+  ros::param::set("/stale/min_pose", 3);
+  ros::param::set("/stale/window_poses", -1);
+  const std::string log = temp("stale_launch.log"), pid = temp("stale_launch.pid");
+  const std::string command =
+      "roslaunch camera_imu_alignment alignment.launch name:=stale manager:=stale_manager "
+      "node:=" +
+      std::string(g_instance_kind == "node" ? "true" : "false") + " target:=" + TARGET_YAML +
+      " output:=" + temp("stale_result.yaml") +
+      " load_on_start:=false camera_frame:=stale_cam imu_frame:=stale_imu "
+      "imu_topic:=/stale/imu/data_raw mag_topic:=/stale/imu/mag "
+      "image_topic:=/stale/camera/image_raw";
+  std::system((command + " >" + log + " 2>&1 & echo $! >" + pid).c_str());
+  const auto status = waitForStatus(
+      60.0, [](const AlignmentStatus&) { return true; }, "/stale");
+  const bool stale_key_left = ros::param::has("/stale/min_pose");
+  std::system(("kill -INT $(cat " + pid + ")").c_str());
+  ros::WallDuration(3.0).sleep();
+  EXPECT_TRUE(status) << test::readTextFile(log);
+  EXPECT_FALSE(stale_key_left);
+  EXPECT_EQ(test::readTextFile(log).find("unknown key"), std::string::npos)
+      << test::readTextFile(log);
+}
+
+TEST_F(AlignmentRos, CompressedImagesThroughItsOwnSubscription) {
+  // image_transport: compressed without image_transport's compressed plugin (Debian has none):
+  // the instance subscribes to <image topic>/compressed itself and decodes like calibrate_bag.
+  ExtraNode node("compressed",
+                 "_image_transport:=compressed _load_on_start:=false" + remapsUnder("compressed"));
+  ASSERT_TRUE(node.started()) << node.log();
+  ros::NodeHandle nh;
+  auto info_pub = nh.advertise<sensor_msgs::CameraInfo>("/compressed/camera/camera_info", 10);
+  auto image_pub =
+      nh.advertise<sensor_msgs::CompressedImage>("/compressed/camera/image_raw/compressed", 10);
+  ASSERT_TRUE(connected(info_pub)) << node.log();
+  ASSERT_TRUE(connected(image_pub)) << node.log();
+  sensor_msgs::CameraInfo info;
+  info.header.frame_id = "compressed_cam";
+  info.width = 64;
+  info.height = 48;
+  info.distortion_model = "plumb_bob";
+  info.D = {0.0, 0.0, 0.0, 0.0, 0.0};
+  info.K = {50.0, 0.0, 32.0, 0.0, 50.0, 24.0, 0.0, 0.0, 1.0};
+  info.header.stamp = ros::Time(200.0);
+  info_pub.publish(info);
+  ros::WallDuration(0.5).sleep();
+  for (int i = 0; i < 4; ++i) {
+    sensor_msgs::CompressedImage image;
+    image.header = info.header;
+    image.header.stamp = ros::Time(200.0 + 0.2 * i);
+    image.format = "png";
+    if (i < 3) {
+      ASSERT_TRUE(cv::imencode(".png", cv::Mat(48, 64, CV_8UC1, cv::Scalar(40 * i)), image.data));
+    } else {
+      image.data = {1, 2, 3, 4};  // not an image: bad_image
+    }
+    image_pub.publish(image);
+    ros::WallDuration(0.05).sleep();
+  }
+  const auto values = waitForDiagnostics("compressed", 30.0, [](const auto& v) {
+    return countOf(v, "frames") == 3 && countOf(v, "rejected bad_image") == 1;
+  });
+  EXPECT_EQ(countOf(values, "frames"), 3) << node.log();
+  EXPECT_EQ(countOf(values, "rejected bad_image"), 1) << node.log();
+  EXPECT_TRUE(node.alive()) << node.log();
 }
 
 TEST_F(AlignmentRos, RealImuOnlyBagsKeepItWaitingForTheCameraWithoutATf) {
@@ -515,10 +634,10 @@ TEST_F(AlignmentRos, HostileInputsAreCountedByReasonAndNothingBreaks) {
     image_pub.publish(image);
     pause();
   };
-  camera(101.02, 64, 48, "mono8", true, 64 * 48);         // bad_camera_info
-  camera(101.04, 32, 24, "mono8", false, 32 * 24);        // bad_image: not the camera info's size
-  camera(101.06, 64, 48, "bayer_rggb8", false, 64 * 48);  // bad_image: encoding
-  camera(101.08, 64, 48, "mono8", false, 0);              // bad_image: no data
+  camera(101.02, 64, 48, "mono8", true, 64 * 48);       // bad_camera_info
+  camera(101.04, 32, 24, "mono8", false, 32 * 24);      // bad_image: not the camera info's size
+  camera(101.06, 64, 48, "nonsense8", false, 64 * 48);  // bad_image: encoding
+  camera(101.08, 64, 48, "mono8", false, 0);            // bad_image: no data
   geometry_msgs::PoseStamped pose;
   pose.header.stamp = ros::Time(101.1);
   pose.pose.orientation.w = 2.0;  // non_finite: not a unit quaternion

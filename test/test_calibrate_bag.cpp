@@ -125,6 +125,25 @@ TEST(CalibrateBag, AMagnetometerInAFrameOfItsOwnIsRotatedByTheBagsTfStatic) {
   removeBag(own);
 }
 
+TEST(CalibrateBag, ExportedPosesGiveSolveRotationTheSameAnswer) {
+  // --export-poses writes the poses the estimate used as solve_rotation's poses CSV: fed to it,
+  // the same pairs give the same rotation (and the truth within the accuracy of the bag).
+  const std::string bag = simulate("export", "--scenario nominal --seed 33 --num-poses 6");
+  const std::string poses = temp("exported_poses.csv"), solved = temp("solved.yaml");
+  std::filesystem::remove(poses);
+  const Calibration result = calibrate(bag, "--export-poses " + poses);
+  ASSERT_EQ(result.run.exit_code, 0) << result.run.err;
+  const test::ToolRun solve =
+      test::runTool(std::string(SOLVE_ROTATION_EXE) + " --poses " + poses + " --output " + solved);
+  ASSERT_EQ(solve.exit_code, 0) << solve.err << test::readTextFile(poses);
+  const YAML::Node yaml = YAML::LoadFile(solved);
+  EXPECT_EQ(yaml["quality"]["num_poses"].as<int>(), 6);
+  EXPECT_EQ(yaml["quality"]["num_pairs"].as<int>(), 15);
+  EXPECT_LT(rad2deg(geodesicDistance(readResultYaml(solved).R_cam_imu, result.R_cam_imu)), 1e-6);
+  EXPECT_LT(rad2deg(geodesicDistance(result.R_cam_imu, result.R_cam_imu_true)), 0.1);
+  removeBag(bag);
+}
+
 TEST(CalibrateBag, FewPosesGiveAnAnswerWhoseSigmaCoversTheError) {
   const std::string bag = simulate("few_poses", "--scenario few_poses --seed 27");
   const Calibration result = calibrate(bag);

@@ -403,6 +403,36 @@ TEST(ResultYaml, ReadOnlyDirectoryKeepsThePreviousFile) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(CsvIo, PoseGroupsSurviveTheFileAndAreNeverPaired) {
+  // calibrate_bag --export-poses: poses of two gyro chains (groups) must not be paired by
+  // solve_rotation either. A single group keeps the plain header.
+  std::mt19937_64 rng(5);
+  std::vector<PoseOrientation> poses(4);
+  for (int i = 0; i < 4; ++i) {
+    poses[i].stamp_s = i;
+    poses[i].R_target_cam = test::randomRotation(rng);
+    poses[i].R_world_imu = test::randomRotation(rng);
+    poses[i].group = i / 2;
+  }
+  const std::string two = tempDir() + "two_groups.csv", one = tempDir() + "one_group.csv";
+  writePosesCsv(two, poses);
+  const std::vector<PoseOrientation> read = readPosesCsv(two);
+  ASSERT_EQ(read.size(), 4u);
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(read[i].group, i / 2);
+  EXPECT_EQ(makeAllPairs(read).size(), 2u);  // (0, 1) and (2, 3), not 6
+  for (auto& p : poses) p.group = 3;
+  writePosesCsv(one, poses);
+  std::ifstream in(one);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header, "stamp,cam_qw,cam_qx,cam_qy,cam_qz,imu_qw,imu_qx,imu_qy,imu_qz");
+  EXPECT_EQ(makeAllPairs(readPosesCsv(one)).size(), 6u);
+  std::ofstream(tempDir() + "bad_group.csv")
+      << "stamp,cam_qw,cam_qx,cam_qy,cam_qz,imu_qw,imu_qx,imu_qy,imu_qz,group\n"
+      << "0,1,0,0,0,1,0,0,0,1.5\n";
+  EXPECT_THROW(readPosesCsv(tempDir() + "bad_group.csv"), InputError);
+}
+
 TEST(ResultYaml, FullDiskKeepsThePreviousFile) {
   // The temporary file is a link to /dev/full: every write fails with ENOSPC, also for root.
   const std::string path = tempDir() + "disk_full.yaml";

@@ -68,13 +68,116 @@ TEST(MessageConversion, EverySupportedEncodingGivesTheGreyImage) {
   }
 }
 
+/// A smooth 38x24 ramp from 0 to 255, flat at 255 in a corner (Bayer demosaicing and yuv422 need
+/// even sizes and no edges; the flat corner keeps the brightest value when demosaiced).
+cv::Mat smoothRamp() {
+  cv::Mat grey(24, 38, CV_8UC1);
+  for (int r = 0; r < grey.rows; ++r) {
+    for (int c = 0; c < grey.cols; ++c) {
+      grey.at<std::uint8_t>(r, c) = cv::saturate_cast<std::uint8_t>(255.0 * (r + c) / 50.0);
+    }
+  }
+  return grey;
+}
+
+/// `grey` as a Bayer mosaic: every filter colour sees the same grey, so demosaicing gives it back.
+cv::Mat bayerOf(const cv::Mat& grey, int depth, double scale) {
+  cv::Mat out;
+  grey.convertTo(out, depth, scale);
+  return out;
+}
+
+/// The largest difference inside a 2-pixel border (demosaicing guesses at the edges).
+double interiorDifference(const cv::Mat& a, const cv::Mat& b) {
+  const cv::Rect inside(2, 2, a.cols - 4, a.rows - 4);
+  return maxDifference(a(inside), b(inside));
+}
+
+TEST(MessageConversion, BayerYuvSixteenBitColourAndFloatImagesThroughCvBridge) {
+  const cv::Mat smooth = smoothRamp();
+  for (const char* pattern : {"rggb", "bggr", "gbrg", "grbg"}) {
+    for (const auto& [bits, scale] : {std::pair<int, double>{8, 1.0}, {16, 16.0}}) {
+      const std::string encoding = "bayer_" + std::string(pattern) + std::to_string(bits);
+      cv::Mat mono;
+      std::string error;
+      const cv::Mat mosaic = bayerOf(smooth, bits == 8 ? CV_8U : CV_16U, scale);
+      ASSERT_TRUE(toMono8(imageMessage(mosaic, encoding), &mono, &error)) << encoding << error;
+      ASSERT_EQ(mono.type(), CV_8UC1);
+      ASSERT_EQ(mono.size(), smooth.size());
+      EXPECT_LE(interiorDifference(mono, smooth), 2.0) << encoding;
+    }
+  }
+  // yuv422 (UYVY): chroma 128 (grey), luma the image.
+  cv::Mat uyvy(smooth.rows, smooth.cols, CV_8UC2);
+  for (int r = 0; r < smooth.rows; ++r) {
+    for (int c = 0; c < smooth.cols; ++c) {
+      uyvy.at<cv::Vec2b>(r, c) = cv::Vec2b(128, smooth.at<std::uint8_t>(r, c));
+    }
+  }
+  // 16-bit colour, a 12-bit Bayer camera, float intensities in [0, 1] (32 and 64 bit): stretched
+  // by their actual range, so the ramp (0..255) comes back.
+  const cv::Mat grey = greyRamp();
+  cv::Mat rgb16, bgra16, grey_f32, grey_f64;
+  cv::cvtColor(grey, rgb16, cv::COLOR_GRAY2RGB);
+  rgb16.convertTo(rgb16, CV_16UC3, 256.0);
+  cv::cvtColor(grey, bgra16, cv::COLOR_GRAY2BGRA);
+  bgra16.convertTo(bgra16, CV_16UC4, 16.0);
+  grey.convertTo(grey_f32, CV_32F, 1.0 / 255.0);
+  grey.convertTo(grey_f64, CV_64F, 1.0 / 255.0);
+  const std::pair<cv::Mat, std::string> cases[] = {{uyvy, "yuv422"},
+                                                   {rgb16, "rgb16"},
+                                                   {bgra16, "bgra16"},
+                                                   {grey_f32, "32FC1"},
+                                                   {grey_f64, "64FC1"}};
+  for (const auto& [image, encoding] : cases) {
+    const cv::Mat expected = image.size() == smooth.size() ? smooth : grey;
+    for (int padding : {0, 3}) {
+      cv::Mat mono;
+      std::string error;
+      ASSERT_TRUE(toMono8(imageMessage(image, encoding, padding), &mono, &error))
+          << encoding << ": " << error;
+      ASSERT_EQ(mono.type(), CV_8UC1);
+      ASSERT_EQ(mono.size(), expected.size());
+      EXPECT_LE(maxDifference(mono, expected), 1.0) << encoding << " padding " << padding;
+    }
+  }
+  // A float image with a NaN pixel: the NaN becomes black, the rest keeps the range.
+  cv::Mat with_nan = grey_f32.clone();
+  with_nan.at<float>(3, 4) = std::numeric_limits<float>::quiet_NaN();
+  cv::Mat mono;
+  std::string error;
+  ASSERT_TRUE(toMono8(imageMessage(with_nan, "32FC1"), &mono, &error)) << error;
+  EXPECT_EQ(mono.at<std::uint8_t>(3, 4), 0);
+  cv::Mat expected = grey.clone();
+  expected.at<std::uint8_t>(3, 4) = 0;
+  EXPECT_LE(maxDifference(mono, expected), 1.0);
+}
+
+TEST(MessageConversion, BigEndianSixteenBitImagesAreRead) {
+  const cv::Mat grey = greyRamp();
+  cv::Mat grey12;
+  grey.convertTo(grey12, CV_16U, 16.0);
+  sensor_msgs::Image msg = imageMessage(grey12, "mono16");
+  for (std::size_t i = 0; i + 1 < msg.data.size(); i += 2) std::swap(msg.data[i], msg.data[i + 1]);
+  msg.is_bigendian = 1;
+  cv::Mat mono;
+  std::string error;
+  ASSERT_TRUE(toMono8(msg, &mono, &error)) << error;
+  EXPECT_LE(maxDifference(mono, grey), 1.0);
+}
+
 TEST(MessageConversion, InconsistentImagesAreRefusedWithAReason) {
   const cv::Mat grey = greyRamp();
   std::string error;
   cv::Mat mono;
-  sensor_msgs::Image msg = imageMessage(grey, "bayer_rggb8");
+  sensor_msgs::Image msg = imageMessage(grey, "nonsense8");  // no such encoding
   EXPECT_FALSE(toMono8(msg, &mono, &error));
-  EXPECT_NE(error.find("bayer_rggb8"), std::string::npos) << error;
+  EXPECT_NE(error.find("nonsense8"), std::string::npos) << error;
+  cv::Mat three;
+  cv::cvtColor(grey, three, cv::COLOR_GRAY2BGR);
+  msg = imageMessage(three, "8UC3");  // three channels, but which is red?
+  EXPECT_FALSE(toMono8(msg, &mono, &error));
+  EXPECT_NE(error.find("no colour order"), std::string::npos) << error;
   msg = imageMessage(grey, "mono8");
   msg.data.resize(msg.data.size() - 1);  // truncated payload
   EXPECT_FALSE(toMono8(msg, &mono, &error));

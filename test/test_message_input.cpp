@@ -216,9 +216,9 @@ TEST(MessageInput, OrientationCovarianceConventions) {
 TEST(MessageInput, BadImagesAreCountedAndNamed) {
   Boundary b;
   ASSERT_TRUE(b.input->setCameraInfo(cameraInfo(64, 48)));
-  sensor_msgs::Image bayer = monoImage(1.0);
-  bayer.encoding = "bayer_rggb8";
-  EXPECT_FALSE(b.input->addImage(bayer));
+  sensor_msgs::Image unknown = monoImage(1.0);
+  unknown.encoding = "nonsense8";  // no such encoding (cv_bridge reads every real one)
+  EXPECT_FALSE(b.input->addImage(unknown));
   sensor_msgs::Image empty = monoImage(2.0);
   empty.data.clear();
   EXPECT_FALSE(b.input->addImage(empty));
@@ -236,7 +236,7 @@ TEST(MessageInput, BadImagesAreCountedAndNamed) {
   EXPECT_EQ(b.count(RejectReason::kBadImage), 5u);
   EXPECT_EQ(b.pipeline->frames(), 0u);
   for (const auto& r : b.rejects) EXPECT_EQ(r.second, InputStream::kImage);
-  EXPECT_NE(b.details[0].find("bayer_rggb8"), std::string::npos) << b.details[0];
+  EXPECT_NE(b.details[0].find("nonsense8"), std::string::npos) << b.details[0];
   EXPECT_NE(b.details[2].find("32x24"), std::string::npos) << b.details[2];
   EXPECT_NE(b.details[2].find("64x48"), std::string::npos) << b.details[2];
 
@@ -247,6 +247,53 @@ TEST(MessageInput, BadImagesAreCountedAndNamed) {
   EXPECT_TRUE(b.input->addImage(monoImage(7.0), false, &grey));  // converted, not fed
   EXPECT_EQ(b.pipeline->frames(), 1u);
   EXPECT_EQ(b.input->cameraFrame(), "camera_optical");
+}
+
+TEST(MessageInput, ImuOrientationMessageWithoutOrientationsIsNotedOnceNamingTheTopic) {
+  PipelineSettings settings;
+  settings.imu_orientation = ImuOrientationSource::kMessage;
+  Boundary b(settings);
+  b.input->setTopicNames([](InputStream stream) {
+    return stream == InputStream::kImu ? std::string("/rig/imu/data") : std::string("other");
+  });
+  for (int i = 0; i < 100; ++i) b.input->addImu(imuAt(1.0 + 0.01 * i));  // covariance[0] = -1
+  ASSERT_EQ(b.notices.size(), 1u);
+  EXPECT_NE(b.notices[0].find("/rig/imu/data"), std::string::npos) << b.notices[0];
+  EXPECT_NE(b.notices[0].find("no orientation"), std::string::npos) << b.notices[0];
+  EXPECT_NE(b.notices[0].find("gyro"), std::string::npos) << b.notices[0];
+  // Orientations arrive, then stop again: said again.
+  sensor_msgs::Imu with = imuAt(3.0);
+  with.orientation_covariance[0] = 0.01;
+  with.orientation.w = 1.0;
+  b.input->addImu(with);
+  b.input->addImu(imuAt(3.01));
+  EXPECT_EQ(b.notices.size(), 2u);
+  // Other sources never say it.
+  Boundary automatic;
+  for (int i = 0; i < 10; ++i) automatic.input->addImu(imuAt(1.0 + 0.01 * i));
+  EXPECT_TRUE(automatic.notices.empty());
+}
+
+TEST(MessageInput, StampsInMessagesAreWrittenInFull) {
+  // Frames at rest without the target, at today's epoch stamps: the reason gives the stamp in full.
+  Boundary b;
+  ASSERT_TRUE(b.input->setCameraInfo(cameraInfo(64, 48)));
+  const double t0 = 1700000000.0;
+  for (int i = 0; i <= 400; ++i) {
+    const double t = t0 + 0.01 * i;
+    b.input->addImu(imuAt(t));
+    if (i >= 150 && i % 25 == 0) b.input->addImage(monoImage(t + 0.005));
+  }
+  ASSERT_GT(b.count(RejectReason::kTargetNotFound), 0u);
+  bool found = false;
+  for (const auto& d : b.details) {
+    EXPECT_EQ(d.find("e+09"), std::string::npos) << d;
+    found = found || d.find("image at 1700000001.505 s") != std::string::npos;
+  }
+  EXPECT_TRUE(found) << b.details.front();
+  // Stamps going backwards, to the microsecond.
+  b.input->addImu(imuAt(t0 + 3.000123));
+  EXPECT_NE(b.details.back().find("1700000003.000123"), std::string::npos) << b.details.back();
 }
 
 TEST(MessageInput, BadCameraInfoIsCountedAndThePreviousOneStays) {

@@ -2,6 +2,8 @@
 // and equal the built-in defaults. Bad files are refused with the file and key named.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <set>
 
@@ -173,8 +175,8 @@ void expectRefused(const std::string& text, const std::string& expected_in_messa
 
 TEST(PipelineConfig, BadFilesAreRefusedNamingTheKey) {
   expectRefused("stationary_window_s: 0.5\nwindow_poses: 1\n", "window_poses");
-  expectRefused("max_gyro_norm_rad_s: -1\n", "max_gyro_norm_rad_s");
-  expectRefused("max_gyro_norm_rad_s: fast\n", "max_gyro_norm_rad_s");
+  expectRefused("max_rate_about_gravity_rad_s: -1\n", "max_rate_about_gravity_rad_s");
+  expectRefused("max_rate_about_gravity_rad_s: fast\n", "max_rate_about_gravity_rad_s");
   expectRefused("stationary_window: 1.0\n", "unknown key 'stationary_window'");
   expectRefused("solver_method: best\n", "solver_method");
   expectRefused("imu_orientation: compass\n", "imu_orientation");
@@ -202,6 +204,84 @@ TEST(WrapperSettings, BadParametersAreRefusedNamingThem) {
   refused("publish_inverse: maybe\n", "publish_inverse");
   refused("window_poses: 1\n", "window_poses");
   refused("camera_frme: cam\n", "unknown key 'camera_frme'");
+}
+
+/// The message for `text` (target_file set), or "" when it was accepted.
+std::string refusal(const std::string& text) {
+  WrapperSettings w;
+  PipelineSettings p;
+  try {
+    parseSettings("target_file: t.yaml\n" + text, "params", &w, &p);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Settings, EveryBadValueNamesTheKeyTheAllowedValuesAndTheValueGiven) {
+  // A value of the wrong kind for every key of both tables: one form, "key = value: must be ...".
+  std::vector<std::string> keys = pipelineConfigKeys();
+  keys.insert(keys.end(), wrapperKeys().begin(), wrapperKeys().end());
+  for (const std::string& key : keys) {
+    const std::string message = refusal(key + ": {a: 1}\n");
+    EXPECT_NE(message.find("params: " + key + " = {a: 1}: must be "), std::string::npos) << message;
+    EXPECT_EQ(message.find("bad conversion"), std::string::npos) << message;
+  }
+  // Out of range or the wrong type: the same form with the allowed range, for the cases.
+  const std::pair<std::string, std::string> cases[] = {
+      {"window_poses: -1", "window_poses = -1: must be an integer within [2, 200]"},
+      {"window_poses: 0", "window_poses = 0: must be within [2, 200]"},
+      {"window_poses: 2.5", "window_poses = 2.5: must be an integer within [2, 200]"},
+      {"max_rate_about_gravity_rad_s: fast",
+       "max_rate_about_gravity_rad_s = fast: must be a finite number > 0"},
+      {"min_poses: -3", "min_poses = -3: must be an integer >= 2"},
+      {"min_poses: lots", "min_poses = lots: must be an integer >= 2"},
+      {"publish_inverse: maybe", "publish_inverse = maybe: must be true or false"},
+      {"image_transport: theora", "image_transport = theora: must be 'raw' or 'compressed'"},
+      {"solver_method: best", "solver_method = best: must be 'optimal' or 'two_step'"},
+      {"mag_hard_iron_t: [1, 2]", "mag_hard_iron_t = [1, 2]: must be a list of 3 finite numbers"},
+      {"two_step_max_iterations: 0", "two_step_max_iterations = 0: must be an integer >= 1"},
+      {"max_std_dev_deg: 0", "max_std_dev_deg = 0: must be a finite number > 0"}};
+  for (const auto& [text, expected] : cases) {
+    const std::string message = refusal(text + "\n");
+    EXPECT_NE(message.find(expected), std::string::npos) << text << " -> " << message;
+  }
+}
+
+TEST(WrapperSettings, TheOutputFileDefaultsToAFileUnderDotRosAndPathsResolveVisibly) {
+  namespace fs = std::filesystem;
+  const std::string home = std::getenv("HOME") ? std::getenv("HOME") : "";
+  ASSERT_FALSE(home.empty());
+  const std::string target = test::processTempDir() + "board.yaml";
+  std::ofstream(target) << "target_type: checkerboard\n";
+  // The default (the documented one, as the launch file passes it) works out of the box.
+  WrapperSettings settings;
+  settings.target_file = target;
+  ASSERT_NO_THROW(resolvePaths(&settings));
+  EXPECT_EQ(settings.output_file, home + "/.ros/camera_imu_alignment.yaml");
+  EXPECT_EQ(settings.target_file, target);
+  // A relative target that is not there: the rule and the absolute path tried.
+  settings.target_file = "no_such_board.yaml";
+  try {
+    resolvePaths(&settings);
+    ADD_FAILURE() << "accepted a missing target";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("target_file 'no_such_board.yaml'"), std::string::npos) << message;
+    EXPECT_NE(message.find("tried " + (fs::current_path() / "no_such_board.yaml").string()),
+              std::string::npos)
+        << message;
+    EXPECT_NE(message.find("~/.ros"), std::string::npos) << message;
+  }
+  // A relative output file is said where it goes.
+  settings.target_file = target;
+  settings.output_file = "result.yaml";
+  const std::vector<std::string> notices = resolvePaths(&settings);
+  ASSERT_EQ(notices.size(), 1u);
+  EXPECT_NE(notices[0].find((fs::current_path() / "result.yaml").string()), std::string::npos)
+      << notices[0];
+  EXPECT_EQ(expandHome("~"), home);
+  EXPECT_EQ(expandHome("~user/x"), "~user/x");  // another user's home: left alone
 }
 
 TEST(PipelineConfig, RosOnlyKeysCanBeSkippedAndPartialFilesKeepTheRest) {

@@ -12,6 +12,7 @@
 
 #include "camera_imu_alignment/io/csv_io.h"
 #include "camera_imu_alignment/io/result_yaml.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 #include "test_helpers.h"
 
 namespace camera_imu_alignment {
@@ -139,6 +140,35 @@ TEST(SolveRotationCli, TwoStepMethodSolvesAModerateMounting) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_LT(test::angleBetweenDeg(resultRotation(r.out), X), 1e-6);
   EXPECT_EQ(YAML::Load(r.out)["solver"]["method"].as<std::string>(), "two_step");
+}
+
+TEST(SolveRotationCli, RollPitchYawInTheOneConventionOfEveryTool) {
+  // A mounting with a negative yaw: Eigen's eulerAngles(2, 1, 0) would print it on the other
+  // branch (yaw in [0, 180]). Every tool prints roll, pitch, yaw with R = Rz(yaw) Ry(pitch)
+  // Rx(roll), the convention beside the numbers, as calibrate_bag and ~calibrate do.
+  const double roll = 30.0, pitch = -50.0, yaw = -120.0;
+  const Eigen::Matrix3d X = (Eigen::AngleAxisd(deg2rad(yaw), Eigen::Vector3d::UnitZ()) *
+                             Eigen::AngleAxisd(deg2rad(pitch), Eigen::Vector3d::UnitY()) *
+                             Eigen::AngleAxisd(deg2rad(roll), Eigen::Vector3d::UnitX()))
+                                .toRotationMatrix();
+  std::mt19937_64 rng(64);
+  RotationPairs pairs;
+  for (int j = 0; j < 20; ++j) pairs.push_back(test::exactPair(X, test::randomRotation(rng)));
+  const std::string path = temp("rpy.csv");
+  writePairsCsv(path, pairs);
+  const RunResult r = run(kSolve + " --pairs " + path);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::smatch m;
+  const std::string num = "(-?[0-9.]+)";
+  ASSERT_TRUE(std::regex_search(r.err, m,
+                                std::regex("roll, pitch, yaw \\(deg, R = Rz\\(yaw\\) Ry\\(pitch\\) "
+                                           "Rx\\(roll\\)\\): \\[" +
+                                           num + ", " + num + ", " + num + "\\]")))
+      << r.err;
+  EXPECT_NEAR(std::stod(m[1]), roll, 1e-3) << r.err;
+  EXPECT_NEAR(std::stod(m[2]), pitch, 1e-3) << r.err;
+  EXPECT_NEAR(std::stod(m[3]), yaw, 1e-3) << r.err;
+  EXPECT_EQ(r.err.find("yaw/pitch/roll"), std::string::npos) << r.err;
 }
 
 TEST(SolveRotationCli, GeneratedExampleWithinItsOneSigma) {

@@ -1,4 +1,6 @@
-// Nodelet camera_imu_alignment/AlignmentNodelet: a thin shell over AlignmentWrapper.
+// Nodelet camera_imu_alignment/AlignmentNodelet: a thin shell over AlignmentWrapper. When it cannot
+// start it logs why (FATAL, naming itself: several may share a manager) and its load fails: the
+// manager unloads it, `nodelet load` exits with an error and a `required` launch stops.
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 
@@ -14,7 +16,8 @@ class AlignmentNodelet : public nodelet::Nodelet {
     try {
       wrapper_ = std::make_unique<AlignmentWrapper>(getNodeHandle(), getPrivateNodeHandle());
     } catch (const std::exception& e) {
-      NODELET_FATAL("camera_imu_alignment: cannot start: %s", e.what());
+      NODELET_FATAL("%s: cannot start: %s", getName().c_str(), e.what());
+      throw;  // not an empty shell without status or services: the load fails visibly
     }
   }
   std::unique_ptr<AlignmentWrapper> wrapper_;

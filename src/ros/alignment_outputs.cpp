@@ -62,7 +62,7 @@ void AlignmentWrapper::Impl::onResult(const AlignmentResult& result) {
             : recalibrating                              ? "recalibrating"
                                                          : "collecting";
     state_message = gate.why;
-    ROS_INFO_THROTTLE(2.0, "camera_imu_alignment: estimate not broadcast: %s", gate.why.c_str());
+    ROS_INFO_THROTTLE(2.0, "%s: estimate not broadcast: %s", name.c_str(), gate.why.c_str());
     publishStatus();
     return;
   }
@@ -82,7 +82,7 @@ void AlignmentWrapper::Impl::onResult(const AlignmentResult& result) {
       save_error.clear();
     } else {
       save_error = error;
-      ROS_ERROR_THROTTLE(10.0, "camera_imu_alignment: %s", error.c_str());
+      ROS_ERROR_THROTTLE(10.0, "%s: %s", name.c_str(), error.c_str());
     }
   }
   publishStatus();
@@ -105,9 +105,8 @@ void AlignmentWrapper::Impl::broadcast(const Eigen::Matrix3d& R_cam_imu, double 
   broadcast_R = R_cam_imu;
   published = PublishedEstimate{R_cam_imu, max_std_dev_deg};
   inconsistent_poses = 0;  // the remount check starts over against the new estimate
-  const Eigen::Vector3d rpy = rollPitchYawDeg(R_cam_imu);
-  ROS_INFO("camera_imu_alignment: broadcasting %s -> %s, R_cam_imu rpy [%.3f, %.3f, %.3f] deg",
-           t.header.frame_id.c_str(), t.child_frame_id.c_str(), rpy.x(), rpy.y(), rpy.z());
+  ROS_INFO("%s: broadcasting %s -> %s, R_cam_imu %s", name.c_str(), t.header.frame_id.c_str(),
+           t.child_frame_id.c_str(), rollPitchYawText(R_cam_imu, 3).c_str());
 }
 
 bool AlignmentWrapper::Impl::save(const AlignmentResult& result, std::string* error) {
@@ -126,14 +125,14 @@ void AlignmentWrapper::Impl::loadSaved() {
   const std::optional<StoredCalibration> stored =
       loadSavedCalibration(settings.output_file, &warning);
   if (!warning.empty())
-    ROS_WARN("camera_imu_alignment: saved calibration not loaded: %s", warning.c_str());
+    ROS_WARN("%s: saved calibration not loaded: %s", name.c_str(), warning.c_str());
   if (!stored) return;
   saved_camera_frame = stored->camera_frame;
   saved_imu_frame = stored->imu_frame;
   broadcast(stored->R_cam_imu, std::numeric_limits<double>::infinity());
   state = "calibrated";
   state_message = "calibration loaded from " + settings.output_file;
-  ROS_INFO("camera_imu_alignment: %s", state_message.c_str());
+  ROS_INFO("%s: %s", name.c_str(), state_message.c_str());
 }
 
 void AlignmentWrapper::Impl::publishStatus() {
@@ -144,8 +143,9 @@ void AlignmentWrapper::Impl::publishStatus() {
     if (pipeline->imuSamples() == 0) {
       state_message = "waiting for IMU data on " + imu_sub.getTopic();
     } else if (!pipeline->hasIntrinsics() && pipeline->frames() == 0) {
-      state_message = "waiting for the camera: nothing on " + camera_sub.getTopic() + " / " +
-                      camera_sub.getInfoTopic() + " / " + camera_pose_sub.getTopic() + " yet";
+      state_message = "waiting for the camera: nothing on " + topicOf(InputStream::kImage) + " / " +
+                      topicOf(InputStream::kCameraInfo) + " / " + camera_pose_sub.getTopic() +
+                      " yet";
     } else {
       state = "collecting";
       state_message = "waiting for stationary poses";

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <image_transport/camera_common.h>
+
 #include "alignment_wrapper_impl.h"
 #include "camera_imu_alignment/io/input_error.h"
 #include "camera_imu_alignment/ros/message_conversion.h"
@@ -18,8 +20,15 @@ AlignmentWrapper::AlignmentWrapper(ros::NodeHandle nh, ros::NodeHandle private_n
 AlignmentWrapper::~AlignmentWrapper() = default;
 
 AlignmentWrapper::Impl::Impl(ros::NodeHandle nh_, ros::NodeHandle private_nh)
-    : nh(nh_), pnh(private_nh), transport(nh_), diagnostics(nh_, private_nh) {
+    : nh(nh_),
+      pnh(private_nh),
+      name(private_nh.getNamespace()),
+      transport(nh_),
+      diagnostics(nh_, private_nh) {
   readSettings(pnh, &settings, &pipeline_settings);
+  for (const std::string& notice : resolvePaths(&settings)) {
+    ROS_WARN("%s: %s", name.c_str(), notice.c_str());
+  }
   const TargetDescription target = loadTargetYaml(settings.target_file);
   PipelineCallbacks callbacks;
   callbacks.on_pose = [this](const StationaryPose& p) { onPose(p); };
@@ -29,24 +38,38 @@ AlignmentWrapper::Impl::Impl(ros::NodeHandle nh_, ros::NodeHandle private_nh)
     onReject(reason, stream, d);
   };
   pipeline = std::make_unique<CalibrationPipeline>(target, pipeline_settings, callbacks);
-  input = std::make_unique<MessageInput>(pipeline.get(), [](const std::string& notice) {
-    ROS_WARN("camera_imu_alignment: %s", notice.c_str());
+  input = std::make_unique<MessageInput>(pipeline.get(), [this](const std::string& notice) {
+    ROS_WARN("%s: %s", name.c_str(), notice.c_str());
   });
+  input->setTopicNames([this](InputStream stream) { return topicOf(stream); });
   debug_detector = std::make_unique<TargetDetector>(target, pipeline_settings.detector);
-  ROS_INFO_STREAM("camera_imu_alignment: target " << target.describe() << " from "
-                                                  << settings.target_file);
+  ROS_INFO_STREAM(name << ": target " << target.describe() << " from " << settings.target_file);
 
   advertise();
   if (settings.load_on_start) loadSaved();
   imu_sub = nh.subscribe("imu/data_raw", 2000, &Impl::onImu, this);
   mag_sub = nh.subscribe("imu/mag", 2000, &Impl::onMag, this);
-  camera_sub = transport.subscribeCamera("camera/image_raw", 30, &Impl::onImage, this,
-                                         image_transport::TransportHints(settings.image_transport));
+  subscribeCamera();
   camera_pose_sub = nh.subscribe("camera_pose", 100, &Impl::onCameraPose, this);
   stale_timer = nh.createWallTimer(ros::WallDuration(0.5), [this](const auto&) { checkStale(); });
-  ROS_INFO_STREAM("camera_imu_alignment: listening on "
-                  << imu_sub.getTopic() << ", " << mag_sub.getTopic() << ", "
-                  << camera_sub.getTopic() << " (+ " << camera_sub.getInfoTopic() << ")");
+  ROS_INFO_STREAM(name << ": listening on " << imu_sub.getTopic() << ", " << mag_sub.getTopic()
+                       << ", " << topicOf(InputStream::kImage) << " (+ "
+                       << topicOf(InputStream::kCameraInfo) << "), " << camera_pose_sub.getTopic());
+}
+
+void AlignmentWrapper::Impl::subscribeCamera() {
+  if (settings.image_transport != "compressed") {
+    camera_sub = transport.subscribeCamera("camera/image_raw", 30, &Impl::onImage, this,
+                                           image_transport::TransportHints("raw"));
+    return;
+  }
+  // As image_transport names them: the remapped image topic, "/compressed" appended; camera_info
+  // beside the image topic.
+  const std::string image_topic = nh.resolveName("camera/image_raw");
+  compressed_sub = nh.subscribe(image_topic + "/compressed", 30, &Impl::onCompressedImage, this);
+  info_sub = nh.subscribe<sensor_msgs::CameraInfo>(
+      image_transport::getCameraInfoTopic(image_topic), 10,
+      [this](const sensor_msgs::CameraInfoConstPtr& info) { latest_info = info; });
 }
 
 std::string AlignmentWrapper::Impl::topicOf(InputStream stream) const {
@@ -56,9 +79,9 @@ std::string AlignmentWrapper::Impl::topicOf(InputStream stream) const {
     case InputStream::kMagnetometer:
       return mag_sub.getTopic();
     case InputStream::kImage:
-      return camera_sub.getTopic();
+      return compressed_sub ? compressed_sub.getTopic() : camera_sub.getTopic();
     case InputStream::kCameraInfo:
-      return camera_sub.getInfoTopic();
+      return info_sub ? info_sub.getTopic() : camera_sub.getInfoTopic();
     case InputStream::kCameraPose:
       return camera_pose_sub.getTopic();
   }
@@ -70,9 +93,9 @@ bool AlignmentWrapper::Impl::acceptStamp(const std_msgs::Header& header, InputSt
   const double jump_s = clock.update(toString(stream), header.stamp.toSec());
   if (jump_s > 0.0) {
     ROS_WARN(
-        "camera_imu_alignment: %s: time jumped back by %.1f s (bag loop or restarted "
+        "%s: %s: time jumped back by %.1f s (bag loop or restarted "
         "clock): buffers reset, the broadcast calibration is kept",
-        topicOf(stream).c_str(), jump_s);
+        name.c_str(), topicOf(stream).c_str(), jump_s);
     pipeline->reset();
     inconsistent_poses = 0;
   }
@@ -88,7 +111,7 @@ void AlignmentWrapper::Impl::applyPendingReset() {
 void AlignmentWrapper::Impl::checkStale() {
   if (input_stopped || (ros::WallTime::now() - last_imu_wall).toSec() < 2.0) return;
   input_stopped = true;
-  ROS_INFO("camera_imu_alignment: no IMU data for 2 s on %s: closing the rest in progress",
+  ROS_INFO("%s: no IMU data for 2 s on %s: closing the rest in progress", name.c_str(),
            imu_sub.getTopic().c_str());
   pipeline->finish();
   applyPendingReset();
@@ -105,9 +128,10 @@ void AlignmentWrapper::Impl::onImu(const sensor_msgs::ImuConstPtr& msg) {
     imu_gaps_warned = pipeline->imuGaps();
     if (imu_gaps_warned > 0) {
       ROS_WARN_THROTTLE(5.0,
-                        "camera_imu_alignment: %s: gap in the IMU data (more than max_imu_gap_s = "
+                        "%s: %s: gap in the IMU data (more than max_imu_gap_s = "
                         "%.2f s; %lu so far): a rest in progress ended there",
-                        imu_sub.getTopic().c_str(), pipeline_settings.stationary.max_gap_s,
+                        name.c_str(), imu_sub.getTopic().c_str(),
+                        pipeline_settings.stationary.max_gap_s,
                         static_cast<unsigned long>(imu_gaps_warned));
     }
   }
@@ -131,15 +155,31 @@ void AlignmentWrapper::Impl::onMag(const sensor_msgs::MagneticFieldConstPtr& msg
 void AlignmentWrapper::Impl::onImage(const sensor_msgs::ImageConstPtr& image,
                                      const sensor_msgs::CameraInfoConstPtr& info) {
   if (!acceptStamp(image->header, InputStream::kImage)) return;
+  handleImage(*image, *info);
+}
+
+void AlignmentWrapper::Impl::onCompressedImage(const sensor_msgs::CompressedImageConstPtr& image) {
+  if (!acceptStamp(image->header, InputStream::kImage)) return;
+  if (!latest_info) {
+    ROS_WARN_THROTTLE(5.0, "%s: %s: images arrive but no camera info on %s yet; frames dropped",
+                      name.c_str(), compressed_sub.getTopic().c_str(), info_sub.getTopic().c_str());
+    return;
+  }
+  handleImage(*image, *latest_info);
+}
+
+template <typename ImageMessage>
+void AlignmentWrapper::Impl::handleImage(const ImageMessage& image,
+                                         const sensor_msgs::CameraInfo& info) {
   ++image_count;
-  if (!input->setCameraInfo(*info)) return;
+  if (!input->setCameraInfo(info)) return;
   const bool wanted = !settings.manual_capture || capture_armed;  // manual: poses only when asked
   const bool debug = debug_pub.getNumSubscribers() > 0;
   if (!wanted && !debug) return;
   cv::Mat mono8;
-  if (!input->addImage(*image, wanted, &mono8)) return;
+  if (!input->addImage(image, wanted, &mono8)) return;
   if (wanted) applyPendingReset();
-  if (debug) publishDebugImage(mono8, image->header);
+  if (debug) publishDebugImage(mono8, image.header);
 }
 
 void AlignmentWrapper::Impl::onCameraPose(const geometry_msgs::PoseStampedConstPtr& msg) {
@@ -152,7 +192,7 @@ void AlignmentWrapper::Impl::onCameraPose(const geometry_msgs::PoseStampedConstP
 void AlignmentWrapper::Impl::onPose(const StationaryPose& pose) {
   last_pose = pose;
   capture_armed = false;
-  ROS_INFO("camera_imu_alignment: stationary pose %d (%.1f s, %d frames, IMU from %s)", pose.index,
+  ROS_INFO("%s: stationary pose %d (%.1f s, %d frames, IMU from %s)", name.c_str(), pose.index,
            pose.end_s - pose.start_s, pose.num_frames, toString(pose.imu_source));
   // Remount check: the new pose's pairs with the rest of the window against the broadcast estimate.
   if (broadcast_R) {
@@ -170,9 +210,9 @@ void AlignmentWrapper::Impl::onPose(const StationaryPose& pose) {
     inconsistent_poses = rms_deg > settings.remount_residual_deg ? inconsistent_poses + 1 : 0;
     if (inconsistent_poses > 0) {
       ROS_WARN(
-          "camera_imu_alignment: pose %d disagrees with the calibration by %.2f deg RMS (%d "
+          "%s: pose %d disagrees with the calibration by %.2f deg RMS (%d "
           "in a row, %d restart the window)",
-          pose.index, rms_deg, inconsistent_poses, settings.remount_poses);
+          name.c_str(), pose.index, rms_deg, inconsistent_poses, settings.remount_poses);
     }
     if (inconsistent_poses >= settings.remount_poses) {
       pipeline->keepNewestPoses(static_cast<std::size_t>(settings.remount_poses));
@@ -182,7 +222,7 @@ void AlignmentWrapper::Impl::onPose(const StationaryPose& pose) {
       state_message =
           "the last poses disagree with the calibration (mount moved?): window "
           "restarted from them";
-      ROS_WARN("camera_imu_alignment: %s", state_message.c_str());
+      ROS_WARN("%s: %s", name.c_str(), state_message.c_str());
     }
   }
   publishPoses();
@@ -190,9 +230,16 @@ void AlignmentWrapper::Impl::onPose(const StationaryPose& pose) {
 }
 
 void AlignmentWrapper::Impl::onPoseRejected(const RejectedPose& rejected) {
+  // manual_capture: a rest during which ~capture_pose was not called saw no camera data on
+  // purpose; the pipeline's reason ("no camera data") would send the user looking for a fault.
+  const std::string reason =
+      settings.manual_capture && !capture_armed
+          ? "not armed (manual_capture: call ~capture_pose during a rest to make it a pose)"
+          : rejected.reason;
   capture_armed = false;
-  ROS_WARN_THROTTLE(2.0, "camera_imu_alignment: rest %.1f-%.1f s not used: %s", rejected.start_s,
-                    rejected.end_s, rejected.reason.c_str());
+  ROS_WARN_THROTTLE(2.0, "%s: rest %s-%s s not used: %s", name.c_str(),
+                    formatStamp(rejected.start_s).c_str(), formatStamp(rejected.end_s).c_str(),
+                    reason.c_str());
 }
 
 void AlignmentWrapper::Impl::onReject(RejectReason reason, InputStream stream,
@@ -208,8 +255,8 @@ void AlignmentWrapper::Impl::onReject(RejectReason reason, InputStream stream,
   const std::string more =
       unwarned > 0 ? " (+" + std::to_string(unwarned) + " more since the last such warning)" : "";
   unwarned = 0;
-  ROS_WARN("camera_imu_alignment: %s: rejected (%s): %s%s", topicOf(stream).c_str(),
-           toString(reason), detail.c_str(), more.c_str());
+  ROS_WARN("%s: %s: rejected (%s): %s%s", name.c_str(), topicOf(stream).c_str(), toString(reason),
+           detail.c_str(), more.c_str());
 }
 
 }  // namespace camera_imu_alignment

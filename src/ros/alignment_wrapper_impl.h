@@ -7,6 +7,7 @@
 #include <image_transport/image_transport.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/MagneticField.h>
@@ -35,6 +36,9 @@ struct AlignmentWrapper::Impl {
   Impl(ros::NodeHandle nh, ros::NodeHandle private_nh);
 
   ros::NodeHandle nh, pnh;
+  /// The instance's name (its private namespace, e.g. "/camera_imu_alignment"): every log line
+  /// starts with it, so that two instances in one manager can be told apart.
+  std::string name;
   WrapperSettings settings;
   PipelineSettings pipeline_settings;
   std::unique_ptr<CalibrationPipeline> pipeline;
@@ -46,7 +50,12 @@ struct AlignmentWrapper::Impl {
   std::unique_ptr<tf2_ros::TransformListener> tf_listener;
   image_transport::ImageTransport transport;
   ros::Subscriber imu_sub, mag_sub, camera_pose_sub;
-  image_transport::CameraSubscriber camera_sub;
+  image_transport::CameraSubscriber camera_sub;  ///< image_transport raw (image + camera info)
+  // image_transport: compressed (Debian ships no compressed image_transport plugin): our own
+  // subscriptions to <image topic>/compressed and the sibling camera_info, whose latest message
+  // goes with each image.
+  ros::Subscriber compressed_sub, info_sub;
+  sensor_msgs::CameraInfoConstPtr latest_info;
   std::unique_ptr<MessageInput> input;  ///< the checks and conversions calibrate_bag uses too
   ClockJumpDetector clock;              ///< bag loops, restarted clocks
   bool reset_requested = false;         ///< applied after the pipeline call returns
@@ -62,6 +71,13 @@ struct AlignmentWrapper::Impl {
   void onMag(const sensor_msgs::MagneticFieldConstPtr& msg);
   void onImage(const sensor_msgs::ImageConstPtr& image,
                const sensor_msgs::CameraInfoConstPtr& info);
+  void onCompressedImage(const sensor_msgs::CompressedImageConstPtr& image);
+  /// The part of onImage and onCompressedImage after the stamp check (same conversion code as
+  /// calibrate_bag: MessageInput::addImage for either message type).
+  template <typename ImageMessage>
+  void handleImage(const ImageMessage& image, const sensor_msgs::CameraInfo& info);
+  /// Subscribes to the camera as settings.image_transport says.
+  void subscribeCamera();
   /// camera_pose (geometry_msgs/PoseStamped, the camera in the target frame): orientations from
   /// the user's own detector or motion capture instead of images.
   void onCameraPose(const geometry_msgs::PoseStampedConstPtr& msg);

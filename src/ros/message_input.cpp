@@ -98,12 +98,38 @@ void MessageInput::lookUpMagnetometerRotation() {
   }
 }
 
+void MessageInput::setTopicNames(std::function<std::string(InputStream)> topic_of) {
+  topic_of_ = std::move(topic_of);
+}
+
+std::string MessageInput::topicOf(InputStream stream) const {
+  return topic_of_ ? topic_of_(stream) : toString(stream);
+}
+
+void MessageInput::checkMessageOrientation(const ImuSample& sample) {
+  if (pipeline_->settings().imu_orientation != ImuOrientationSource::kMessage) return;
+  if (sample.q_world_imu) {
+    noted_missing_orientation_ = false;
+    return;
+  }
+  if (noted_missing_orientation_) return;
+  noted_missing_orientation_ = true;
+  if (notice_) {
+    notice_(topicOf(InputStream::kImu) +
+            ": imu_orientation is 'message' but the Imu messages carry no orientation "
+            "(orientation_covariance[0] = -1 or a zero quaternion): the gyro and accelerometer "
+            "give the IMU's orientation instead (imu_orientation: auto)");
+  }
+}
+
 void MessageInput::addImu(const sensor_msgs::Imu& msg) {
   if (!checkStamp(msg.header, InputStream::kImu)) return;
   noteFrame(msg.header.frame_id, &imu_frame_, "the IMU's");
   lookUpMagnetometerRotation();
   checkMagFrame();
-  pipeline_->addImu(toImuSample(msg));
+  const ImuSample sample = toImuSample(msg);
+  checkMessageOrientation(sample);
+  pipeline_->addImu(sample);
 }
 
 void MessageInput::addMagnetic(const sensor_msgs::MagneticField& msg) {

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <sstream>
 
 #include "camera_imu_alignment/io/input_error.h"
@@ -16,29 +18,52 @@ namespace {
 using Key = SettingKey<WrapperSettings>;
 
 template <typename T>
-Key field(const std::string& name, T WrapperSettings::*member) {
-  return fieldKey<T, WrapperSettings>(name, [member](WrapperSettings* s) { return &(s->*member); });
+Key field(const std::string& name, T WrapperSettings::*member, const std::string& allowed) {
+  return fieldKey<T, WrapperSettings>(
+      name, [member](WrapperSettings* s) { return &(s->*member); }, allowed);
 }
+
+// The ranges check() applies, as told in messages.
+const char* const kPath = "a file path (text)";
+const char* const kFrame = "a tf frame name (text), or empty";
+const char* const kBool = "true or false";
+const char* const kPositive = "a finite number > 0";
 
 const std::vector<Key>& keys() {
   static const std::vector<Key> table = {
-      field("target_file", &WrapperSettings::target_file),
-      field("camera_frame", &WrapperSettings::camera_frame),
-      field("imu_frame", &WrapperSettings::imu_frame),
-      field("publish_inverse", &WrapperSettings::publish_inverse),
-      field("output_file", &WrapperSettings::output_file),
-      field("load_on_start", &WrapperSettings::load_on_start),
-      field("min_poses", &WrapperSettings::min_poses),
-      field("max_residual_deg", &WrapperSettings::max_residual_deg),
-      field("max_std_dev_deg", &WrapperSettings::max_std_dev_deg),
-      field("min_change_deg", &WrapperSettings::min_change_deg),
-      field("manual_capture", &WrapperSettings::manual_capture),
-      field("remount_poses", &WrapperSettings::remount_poses),
-      field("remount_residual_deg", &WrapperSettings::remount_residual_deg),
-      field("status_period_s", &WrapperSettings::status_period_s),
-      field("image_transport", &WrapperSettings::image_transport),
+      field("target_file", &WrapperSettings::target_file, kPath),
+      field("camera_frame", &WrapperSettings::camera_frame, kFrame),
+      field("imu_frame", &WrapperSettings::imu_frame, kFrame),
+      field("publish_inverse", &WrapperSettings::publish_inverse, kBool),
+      field("output_file", &WrapperSettings::output_file, "a file path (text), or empty"),
+      field("load_on_start", &WrapperSettings::load_on_start, kBool),
+      field("min_poses", &WrapperSettings::min_poses, "an integer >= 2"),
+      field("max_residual_deg", &WrapperSettings::max_residual_deg, kPositive),
+      field("max_std_dev_deg", &WrapperSettings::max_std_dev_deg, kPositive),
+      field("min_change_deg", &WrapperSettings::min_change_deg, "a finite number >= 0"),
+      field("manual_capture", &WrapperSettings::manual_capture, kBool),
+      field("remount_poses", &WrapperSettings::remount_poses, "an integer >= 1"),
+      field("remount_residual_deg", &WrapperSettings::remount_residual_deg, kPositive),
+      field("status_period_s", &WrapperSettings::status_period_s, kPositive),
+      {"image_transport",
+       [](const YAML::Node& node, WrapperSettings* s) {
+         const std::string transport = node.as<std::string>();
+         if (transport != "raw" && transport != "compressed") {
+           throw YAML::Exception(node.Mark(), "unknown transport");
+         }
+         s->image_transport = transport;
+       },
+       "'raw' or 'compressed'"},
   };
   return table;
+}
+
+/// "<key> = <value>: must be <allowed>" for check(), with the table's words.
+template <typename T>
+std::string bad(const std::string& name, const T& value) {
+  std::ostringstream text;
+  text << value;
+  return name + " = " + text.str() + ": must be " + findKey(keys(), name)->allowed;
 }
 
 /// XmlRpc parameter value -> YAML node (scalars and lists; maps are not settings).
@@ -64,29 +89,57 @@ YAML::Node toYaml(XmlRpc::XmlRpcValue& value, const std::string& name) {
 }
 
 std::string check(const WrapperSettings& s) {
-  std::ostringstream out;
   auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
-  if (s.target_file.empty()) {
-    out << "target_file is required (a Kalibr target YAML)";
-  } else if (s.min_poses < 2) {
-    out << "min_poses = " << s.min_poses << ": must be >= 2";
-  } else if (!positive(s.max_residual_deg)) {
-    out << "max_residual_deg = " << s.max_residual_deg << ": must be > 0";
-  } else if (!positive(s.max_std_dev_deg)) {
-    out << "max_std_dev_deg = " << s.max_std_dev_deg << ": must be > 0";
-  } else if (!(std::isfinite(s.min_change_deg) && s.min_change_deg >= 0.0)) {
-    out << "min_change_deg = " << s.min_change_deg << ": must be >= 0";
-  } else if (s.remount_poses < 1) {
-    out << "remount_poses = " << s.remount_poses << ": must be >= 1";
-  } else if (!positive(s.remount_residual_deg)) {
-    out << "remount_residual_deg = " << s.remount_residual_deg << ": must be > 0";
-  } else if (!positive(s.status_period_s)) {
-    out << "status_period_s = " << s.status_period_s << ": must be > 0";
+  if (s.target_file.empty()) return "target_file is required (a Kalibr target YAML)";
+  if (s.min_poses < 2) return bad("min_poses", s.min_poses);
+  if (!positive(s.max_residual_deg)) return bad("max_residual_deg", s.max_residual_deg);
+  if (!positive(s.max_std_dev_deg)) return bad("max_std_dev_deg", s.max_std_dev_deg);
+  if (!(std::isfinite(s.min_change_deg) && s.min_change_deg >= 0.0)) {
+    return bad("min_change_deg", s.min_change_deg);
   }
-  return out.str();
+  if (s.remount_poses < 1) return bad("remount_poses", s.remount_poses);
+  if (!positive(s.remount_residual_deg)) {
+    return bad("remount_residual_deg", s.remount_residual_deg);
+  }
+  if (!positive(s.status_period_s)) return bad("status_period_s", s.status_period_s);
+  return "";
 }
 
 }  // namespace
+
+std::string expandHome(const std::string& path) {
+  if (path.empty() || path[0] != '~' || (path.size() > 1 && path[1] != '/')) return path;
+  const char* home = std::getenv("HOME");
+  return home ? std::string(home) + path.substr(1) : path;
+}
+
+std::vector<std::string> resolvePaths(WrapperSettings* settings) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> notices;
+  const std::string where =
+      "a relative path resolves from the node's working directory (ROS_HOME under roslaunch, "
+      "~/.ros by default), not from where roslaunch was typed";
+  const std::string target = expandHome(settings->target_file);
+  std::error_code error;
+  const fs::path target_abs = fs::absolute(target, error);
+  if (!fs::is_regular_file(target_abs, error)) {
+    const bool relative = fs::path(target).is_relative();
+    throw InputError("target_file '" + settings->target_file + "': no such file: tried " +
+                     target_abs.string() +
+                     (relative ? "; " + where + ": give an absolute path" : ""));
+  }
+  settings->target_file = target_abs.string();
+  if (!settings->output_file.empty()) {
+    const std::string output = expandHome(settings->output_file);
+    const std::string output_abs = fs::absolute(output, error).string();
+    if (fs::path(output).is_relative()) {
+      notices.push_back("output_file '" + settings->output_file + "' is a relative path: " + where +
+                        "; the calibration is written to " + output_abs);
+    }
+    settings->output_file = output_abs;
+  }
+  return notices;
+}
 
 const std::vector<std::string>& wrapperKeys() {
   static const std::vector<std::string> names = keyNames(keys());
@@ -109,8 +162,8 @@ void parseSettings(const YAML::Node& root, const std::string& source, WrapperSet
       }
       try {
         key->read(entry.second, &updated);
-      } catch (const YAML::Exception& e) {
-        throw InputError(source + ": parameter '" + name + "': " + e.msg);
+      } catch (const YAML::Exception&) {
+        throw InputError(badValueMessage(source, name, yamlText(entry.second), key->allowed));
       }
     }
   }

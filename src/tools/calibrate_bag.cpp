@@ -22,6 +22,7 @@
 
 #include "bag_topics.h"
 #include "camera_imu_alignment/io/calibration_report.h"
+#include "camera_imu_alignment/io/csv_io.h"
 #include "camera_imu_alignment/io/default_frames.h"
 #include "camera_imu_alignment/io/input_error.h"
 #include "camera_imu_alignment/io/joint_yaml.h"
@@ -48,7 +49,7 @@ const char* kUsage =
     "                     [--camera-info-topic T] [--method optimal|two_step]\n"
     "                     [--imu-orientation joint|auto|magnetometer|message]\n"
     "                     [--output RESULT.yaml] [--imu-yaml IMU.yaml] [--report REPORT.png]\n"
-    "                     [--truth TRUTH.yaml] [--quiet]\n"
+    "                     [--truth TRUTH.yaml] [--export-poses POSES.csv] [--quiet]\n"
     "  --bag FILE.bag        ROS 1 bag: sensor_msgs/Imu, optional MagneticField, Image or\n"
     "                        CompressedImage and CameraInfo (topics found by type when not given)\n"
     "  --target TARGET.yaml  Kalibr target file (checkerboard, aprilgrid, circlegrid)\n"
@@ -63,6 +64,8 @@ const char* kUsage =
     "                        at the rests) with the calibrated IMU intrinsics added\n"
     "  --report REPORT.png   write a one-page report: residuals, axis coverage, rests, estimate\n"
     "  --truth TRUTH.yaml    a YAML with R_cam_imu (e.g. simulate_bag's) to print the error to\n"
+    "  --export-poses POSES.csv  write the stationary poses the estimate used (the window) as the\n"
+    "                        poses CSV that solve_rotation --poses reads (doc/CONVENTIONS.md)\n"
     "  --quiet               no progress on stderr\n"
     "exit codes: 0 success, 2 bad input or usage, 3 not enough information (the message says what\n"
     "motion is missing)\n";
@@ -115,9 +118,8 @@ class Progress {
     line << "[calibrate_bag] " << std::setw(3) << std::min(percent, 100) << "% of bag time, "
          << pipeline.segments().size() << " rests, " << pipeline.poses().size() << " poses";
     if (const auto result = pipeline.lastResult()) {
-      const Eigen::Vector3d rpy = cia::rollPitchYawDeg(result->R_cam_imu);
-      line << std::fixed << std::setprecision(2) << ", R_cam_imu rpy [" << rpy.x() << ", "
-           << rpy.y() << ", " << rpy.z() << "] deg +- " << result->quality.std_dev_deg.maxCoeff();
+      line << ", R_cam_imu " << cia::rollPitchYawText(result->R_cam_imu, 2) << " +- " << std::fixed
+           << std::setprecision(2) << result->quality.std_dev_deg.maxCoeff();
     }
     if (tty_) {
       std::cerr << "\r\033[K" << line.str() << std::flush;
@@ -235,6 +237,23 @@ void readBag(const rosbag::Bag& bag, const cia::BagTopics& topics,
   progress->done();
 }
 
+/// The poses of the pipeline's window (those the estimate used), as the poses CSV holds them: the
+/// stamp in the middle of the rest, as the window itself pairs them.
+std::vector<cia::PoseOrientation> windowPoses(const cia::CalibrationPipeline& pipeline) {
+  const std::vector<cia::StationaryPose>& history = pipeline.poses();
+  const std::size_t first = history.size() - std::min(history.size(), pipeline.windowSize());
+  std::vector<cia::PoseOrientation> poses;
+  for (std::size_t i = first; i < history.size(); ++i) {
+    cia::PoseOrientation pose;
+    pose.stamp_s = 0.5 * (history[i].start_s + history[i].end_s);
+    pose.R_target_cam = history[i].R_target_cam;
+    pose.R_world_imu = history[i].R_world_imu;
+    pose.group = history[i].group;
+    poses.push_back(pose);
+  }
+  return poses;
+}
+
 /// The whole job; returns the exit code.
 int run(const cia::CliArgs& args) {
   // --- Inputs: target, settings, bag, topics. Each failure names its file, option or topic.
@@ -350,6 +369,14 @@ int run(const cia::CliArgs& args) {
       return kExitBadInput;
     }
   }
+  if (args.has("--export-poses")) {
+    try {
+      cia::writePosesCsv(args.get("--export-poses"), windowPoses(pipeline));
+    } catch (const cia::InputError& e) {
+      std::cerr << "calibrate_bag: --export-poses " << e.what() << "\n";
+      return kExitBadInput;
+    }
+  }
   const cia::SolveStatus status = report.result.status;
   if (status != cia::SolveStatus::kOk) {
     std::cerr << "calibrate_bag: " << report.result.message << "\n";
@@ -379,7 +406,7 @@ int main(int argc, char** argv) {
       return cia::CliArgs(argc, argv,
                           {"--bag", "--target", "--config", "--imu-topic", "--mag-topic",
                            "--image-topic", "--camera-info-topic", "--method", "--imu-orientation",
-                           "--output", "--imu-yaml", "--report", "--truth"},
+                           "--output", "--imu-yaml", "--report", "--truth", "--export-poses"},
                           {"--help", "--quiet"});
     } catch (const cia::UsageError& e) {
       std::cerr << "calibrate_bag: " << e.what() << "\n" << kUsage;

@@ -43,13 +43,11 @@ void printSummary(const cia::AlignmentResult& r) {
   const Eigen::Matrix3d& R = r.R_cam_imu;
   Eigen::Quaterniond q(R);
   if (q.w() < 0.0) q.coeffs() = -q.coeffs();
-  const Eigen::Vector3d ypr = R.eulerAngles(2, 1, 0);
   std::cerr << std::fixed << std::setprecision(4);
   std::cerr << "R_cam_imu (p_cam = R_cam_imu * p_imu), method " << cia::toString(r.method) << ":\n"
             << "  quaternion xyzw: [" << q.x() << ", " << q.y() << ", " << q.z() << ", " << q.w()
             << "]\n"
-            << "  yaw/pitch/roll (ZYX, deg): [" << cia::rad2deg(ypr(0)) << ", "
-            << cia::rad2deg(ypr(1)) << ", " << cia::rad2deg(ypr(2)) << "]\n"
+            << "  " << cia::rollPitchYawText(R, 4) << "\n"
             << "  1-sigma about camera x/y/z (deg): [" << r.quality.std_dev_deg.transpose() << "]\n"
             << "  residual RMS (deg): " << r.quality.residual_rms_deg << ", inliers "
             << r.quality.num_inliers << "/" << r.quality.num_pairs << ", iterations "

@@ -19,14 +19,15 @@ constexpr double kQuaternionNormTolerance = 1e-2;
 /// (pose indices -1). Throws InputError.
 RotationPairs readPairsCsv(const std::string& path);
 
-/// Poses file: stamp, cam_qw..cam_qz (q_target_cam), imu_qw..imu_qz (q_world_imu). Throws
+/// Poses file: stamp, cam_qw..cam_qz (q_target_cam), imu_qw..imu_qz (q_world_imu), optional
+/// group (an integer; poses of different groups are never paired; absent: one group). Throws
 /// InputError.
 std::vector<PoseOrientation> readPosesCsv(const std::string& path);
 
 /// Writes a pairs file (header + one row per pair).
 void writePairsCsv(const std::string& path, const RotationPairs& pairs);
 
-/// Writes a poses file (header + one row per pose).
+/// Writes a poses file (header + one row per pose; a group column when the poses have several).
 void writePosesCsv(const std::string& path, const std::vector<PoseOrientation>& poses);
 
 }  // namespace camera_imu_alignment

@@ -34,6 +34,10 @@ const char* toString(InputStream stream);
 /// Short snake_case name of a reason ("non_finite", "stamp_backwards", ...), for logs and reports.
 const char* toString(RejectReason reason);
 
+/// A stamp (s) in full for messages, to the microsecond without trailing zeros: "1700000001.5",
+/// "1700000001.000123", never "1.7e+09".
+std::string formatStamp(double stamp_s);
+
 /// Counts of rejected inputs by reason.
 class RejectionCounts {
  public:

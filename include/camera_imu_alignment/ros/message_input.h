@@ -12,7 +12,8 @@
 // Frame ids are kept without a leading slash (tf2 refuses "/imu"). A magnetometer whose frame_id
 // differs from the IMU's is rotated into the IMU frame when the caller knows the rotation
 // (setMagnetometerRotation, or looked up in tf: setTransforms), and otherwise assumed to share the
-// IMU's axes, with a notice.
+// IMU's axes, with a notice. With imu_orientation: message, Imu messages without an orientation
+// (the pipeline then uses the gyro and accelerometer) are noted once, naming the topic.
 #pragma once
 
 #include <geometry_msgs/PoseStamped.h>
@@ -61,6 +62,10 @@ class MessageInput {
   /// False (counted as missing_stamp) when the header stamp is zero.
   bool checkStamp(const std_msgs::Header& header, InputStream stream);
 
+  /// The topic each stream arrives on, to name it in notices (the nodelet's resolved topics,
+  /// calibrate_bag's bag topics); without it notices name the stream ("imu").
+  void setTopicNames(std::function<std::string(InputStream)> topic_of);
+
   /// R_imu_mag: maps magnetometer-frame vectors into the IMU frame (from tf, when frames differ).
   void setMagnetometerRotation(const Eigen::Matrix3d& R_imu_mag);
   bool hasMagnetometerRotation() const { return R_imu_mag_.has_value(); }
@@ -86,6 +91,10 @@ class MessageInput {
                    cv::Mat grey, bool feed, cv::Mat* mono8);
   void noteFrame(const std::string& frame_id, std::string* kept, const char* input);
   void checkMagFrame();
+  /// imu_orientation: message and the Imu messages carry none: a notice once (again after
+  /// messages with an orientation came in between), naming the topic.
+  void checkMessageOrientation(const ImuSample& sample);
+  std::string topicOf(InputStream stream) const;
   void lookUpMagnetometerRotation();
   bool waitingForRotation() const;
 
@@ -99,6 +108,8 @@ class MessageInput {
   std::chrono::steady_clock::time_point last_lookup_;  ///< of R_imu_mag (throttled)
   std::optional<std::chrono::steady_clock::time_point> waiting_since_;  ///< first needed
   std::optional<sensor_msgs::CameraInfo> info_in_use_;  ///< the last accepted camera info
+  std::function<std::string(InputStream)> topic_of_;
+  bool noted_missing_orientation_ = false;
 };
 
 }  // namespace camera_imu_alignment

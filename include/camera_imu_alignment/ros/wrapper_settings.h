@@ -17,8 +17,10 @@ struct WrapperSettings {
   std::string camera_frame;      ///< tf frame of the camera; "" = the image header's frame_id
   std::string imu_frame;         ///< tf frame of the IMU; "" = the Imu header's frame_id
   bool publish_inverse = false;  ///< broadcast imu -> camera (parent IMU) instead of camera -> imu
-  std::string output_file;       ///< each accepted calibration is written here ("" = not saved)
-  bool load_on_start = true;     ///< broadcast output_file's calibration at start if it exists
+  /// Each accepted calibration is written here ("" = not saved); "~" is the user's home
+  /// (resolvePaths expands it), so ~save works out of the box.
+  std::string output_file = "~/.ros/camera_imu_alignment.yaml";
+  bool load_on_start = true;  ///< broadcast output_file's calibration at start if it exists
   // Quality gates: an estimate is broadcast only when observable and all of these hold.
   int min_poses = 3;              ///< stationary poses in the window
   double max_residual_deg = 1.0;  ///< RMS pair residual (deg)
@@ -33,6 +35,16 @@ struct WrapperSettings {
   /// image_transport's own parameter: "raw", or "compressed" for CompressedImage topics.
   std::string image_transport = "raw";
 };
+
+/// "~" and "~/..." with $HOME; every other path as it is.
+std::string expandHome(const std::string& path);
+
+/// At start: expands "~" in target_file and output_file and makes them absolute. A relative path
+/// resolves from the node's working directory, which under roslaunch is ROS_HOME (~/.ros), not
+/// where the user typed the command: a missing target file is an InputError naming the
+/// parameter, the path given, that rule and the absolute path tried. Returns notices for the log
+/// (a relative output_file: where it will be written).
+std::vector<std::string> resolvePaths(WrapperSettings* settings);
 
 /// The wrapper's own keys (the pipeline's are pipelineConfigKeys()).
 const std::vector<std::string>& wrapperKeys();

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <string>
 
 namespace camera_imu_alignment {
 
@@ -48,6 +49,10 @@ Eigen::Matrix3d uniformRotation(double u1, double u2, double u3);
 /// Roll, pitch, yaw (deg) with R = Rz(yaw) Ry(pitch) Rx(roll): the x-y-z fixed-axis convention of
 /// tf and of every output of this package. At pitch +-90 deg roll is reported as 0.
 Eigen::Vector3d rollPitchYawDeg(const Eigen::Matrix3d& R);
+
+/// rollPitchYawDeg as every tool, log line and summary prints it, the convention beside the
+/// numbers: "roll, pitch, yaw (deg, R = Rz(yaw) Ry(pitch) Rx(roll)): [66.58, -61.35, -105.97]".
+std::string rollPitchYawText(const Eigen::Matrix3d& R, int decimals);
 
 /// Degrees <-> radians.
 constexpr double kPi = 3.14159265358979323846;

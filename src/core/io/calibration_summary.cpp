@@ -85,8 +85,7 @@ void writeEstimate(std::ostream& out, const ReportInput& in) {
       << fixed(q.z(), 9) << ", " << fixed(q.w(), 9) << "]\n";
   out << "  matrix:\n";
   for (int i = 0; i < 3; ++i) out << "    " << fixedList(R.row(i).transpose(), 9) << "\n";
-  out << "  roll, pitch, yaw (deg, R = Rz(yaw) Ry(pitch) Rx(roll)): "
-      << fixedList(rollPitchYawDeg(R), 4) << "\n";
+  out << "  " << rollPitchYawText(R, 4) << "\n";
 }
 
 /// The joint estimate: consistency, which IMU errors were estimated or held, what to rotate.

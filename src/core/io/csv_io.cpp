@@ -1,6 +1,7 @@
 #include "camera_imu_alignment/io/csv_io.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -68,6 +69,7 @@ class CsvTable {
   }
 
   size_t size() const { return rows_.size(); }
+  bool hasColumn(const std::string& column) const { return columns_.count(column) > 0; }
   int lineNumber(size_t row) const { return rows_[row].first; }
 
   double value(size_t row, const std::string& column) const {
@@ -139,6 +141,13 @@ std::vector<PoseOrientation> readPosesCsv(const std::string& path) {
         table.quaternion(i, "cam_qw", "cam_qx", "cam_qy", "cam_qz").toRotationMatrix();
     poses[i].R_world_imu =
         table.quaternion(i, "imu_qw", "imu_qx", "imu_qy", "imu_qz").toRotationMatrix();
+    if (table.hasColumn("group")) {
+      const double group = table.value(i, "group");
+      if (group != std::floor(group) || std::abs(group) > 1e9) {
+        table.fail(i, "column group: '" + std::to_string(group) + "' is not an integer");
+      }
+      poses[i].group = static_cast<int>(group);
+    }
   }
   return poses;
 }
@@ -161,12 +170,19 @@ void writePosesCsv(const std::string& path, const std::vector<PoseOrientation>& 
   std::ofstream out(path);
   if (!out) throw InputError(path + ": cannot write file");
   out.precision(17);
-  out << "stamp,cam_qw,cam_qx,cam_qy,cam_qz,imu_qw,imu_qx,imu_qy,imu_qz\n";
+  // The group column only when there is more than one group (poses of different groups are never
+  // paired); files of a single group keep the plain header.
+  const bool groups = std::any_of(poses.begin(), poses.end(), [&](const PoseOrientation& p) {
+    return p.group != poses.front().group;
+  });
+  out << "stamp,cam_qw,cam_qx,cam_qy,cam_qz,imu_qw,imu_qx,imu_qy,imu_qz" << (groups ? ",group" : "")
+      << "\n";
   for (const auto& p : poses) {
     out << p.stamp_s << ',';
     writeQuaternion(out, p.R_target_cam);
     out << ',';
     writeQuaternion(out, p.R_world_imu);
+    if (groups) out << ',' << p.group;
     out << '\n';
   }
   if (!out) throw InputError(path + ": write error");

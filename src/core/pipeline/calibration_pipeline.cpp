@@ -96,6 +96,15 @@ std::string PipelineSettings::validate() const {
       {"mag_max_norm_change", disturbance.max_norm_change},
       {"mag_max_dip_change_deg", disturbance.max_dip_change_deg},
       {"mag_max_scatter_deg", disturbance.max_within_segment_std_deg},
+      {"imu_prior_gyro_scale", joint.priors.gyro_scale},
+      {"imu_prior_gyro_cross_axis", joint.priors.gyro_cross_axis},
+      {"imu_prior_gyro_bias_walk_rad_s_sqrt_s", joint.priors.gyro_bias_walk_rad_s_sqrt_s},
+      {"imu_prior_accel_scale", joint.priors.accel_scale},
+      {"imu_prior_accel_cross_axis", joint.priors.accel_cross_axis},
+      {"imu_prior_accel_bias_m_s2", joint.priors.accel_bias_m_s2},
+      {"imu_prior_soft_iron_scale", joint.priors.soft_iron_scale},
+      {"imu_prior_soft_iron_cross", joint.priors.soft_iron_cross},
+      {"imu_prior_hard_iron_t", joint.priors.hard_iron_t},
   };
   for (const auto& [name, value] : more_positives) {
     const std::string error = positive(name, value);
@@ -172,14 +181,14 @@ bool CalibrationPipeline::Impl::checkStamp(double stamp, double* last, InputStre
   Impl* impl = this;
   if (stamp < *last) {
     std::ostringstream out;
-    out << std::setprecision(15) << "stamp " << stamp << " s is earlier than the previous one ("
-        << *last << " s); sample dropped";
+    out << "stamp " << formatStamp(stamp) << " s is earlier than the previous one ("
+        << formatStamp(*last) << " s); sample dropped";
     impl->reject(RejectReason::kStampBackwards, stream, out.str());
     return false;
   }
   if (stamp == *last) {
     std::ostringstream out;
-    out << std::setprecision(15) << "duplicate stamp " << stamp << " s; sample dropped";
+    out << "duplicate stamp " << formatStamp(stamp) << " s; sample dropped";
     impl->reject(RejectReason::kDuplicateStamp, stream, out.str());
     return false;
   }
@@ -344,7 +353,8 @@ void CalibrationPipeline::Impl::processFrame(const CameraFrame& frame) {
   if (!detector.detect(frame.mono8, &observation, hint)) {
     ++misses_in_a_row;
     std::ostringstream out;
-    out << "image at " << frame.stamp_s << " s (at rest): " << target.describe() << " not found";
+    out << "image at " << formatStamp(frame.stamp_s) << " s (at rest): " << target.describe()
+        << " not found";
     reject(RejectReason::kTargetNotFound, InputStream::kImage, out.str());
     return;
   }
@@ -352,7 +362,7 @@ void CalibrationPipeline::Impl::processFrame(const CameraFrame& frame) {
   const auto pose = estimateCameraPose(observation, target, *intrinsics, settings.pose, &why);
   if (!pose) {
     reject(RejectReason::kPoseRejected, InputStream::kImage,
-           "image at " + std::to_string(frame.stamp_s) + " s: " + why);
+           "image at " + formatStamp(frame.stamp_s) + " s: " + why);
     return;
   }
   misses_in_a_row = 0;

@@ -1,9 +1,21 @@
 // Rejection reasons and their counts.
 #include "camera_imu_alignment/pipeline/input_rejections.h"
 
+#include <iomanip>
 #include <sstream>
 
 namespace camera_imu_alignment {
+
+std::string formatStamp(double stamp_s) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(6) << stamp_s;  // a double holds ~0.2 us at 1.7e9 s
+  std::string text = out.str();
+  const std::size_t point = text.find('.');
+  if (point == std::string::npos) return text;  // inf, nan
+  std::size_t end = text.find_last_not_of('0');
+  if (end == point) ++end;  // keep one decimal: "12.0"
+  return text.substr(0, end + 1);
+}
 
 const char* toString(RejectReason reason) {
   switch (reason) {

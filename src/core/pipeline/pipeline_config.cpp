@@ -15,100 +15,157 @@ namespace {
 using Key = SettingKey<PipelineSettings>;
 
 template <typename T, typename Access>
-Key number(const std::string& name, Access access) {
-  return fieldKey<T, PipelineSettings>(name, access);
+Key number(const std::string& name, Access access, const std::string& allowed) {
+  return fieldKey<T, PipelineSettings>(name, access, allowed);
 }
+
+// The ranges PipelineSettings::validate() applies, as told in messages.
+const char* const kPositive = "a finite number > 0";
+const char* const kNonNegative = "a finite number >= 0";
 
 const std::vector<Key>& keys() {
   static const std::vector<Key> table = {
       // Stationary detection (IMU).
-      number<double>("stationary_window_s", [](auto* s) { return &s->stationary.window_s; }),
-      number<double>("min_stationary_duration_s",
-                     [](auto* s) { return &s->stationary.min_duration_s; }),
-      number<double>("max_gyro_std_rad_s",
-                     [](auto* s) { return &s->stationary.max_gyro_std_rad_s; }),
-      number<double>("max_accel_std_m_s2",
-                     [](auto* s) { return &s->stationary.max_accel_std_m_s2; }),
-      number<double>("stationary_noise_factor",
-                     [](auto* s) { return &s->stationary.noise_factor; }),
-      number<double>("max_gyro_change_rad_s",
-                     [](auto* s) { return &s->stationary.max_gyro_change_rad_s; }),
-      number<double>("max_gravity_turn_rate_rad_s",
-                     [](auto* s) { return &s->stationary.max_gravity_turn_rate_rad_s; }),
-      number<double>("stationary_change_noise_factor",
-                     [](auto* s) { return &s->stationary.change_noise_factor; }),
-      number<double>("max_gyro_bias_rad_s",
-                     [](auto* s) { return &s->stationary.max_gyro_bias_rad_s; }),
-      number<double>("max_rate_about_gravity_rad_s",
-                     [](auto* s) { return &s->stationary.max_rate_about_gravity_rad_s; }),
-      number<double>("max_gravity_error_m_s2",
-                     [](auto* s) { return &s->stationary.max_gravity_error_m_s2; }),
-      number<double>("gravity_m_s2", [](auto* s) { return &s->stationary.gravity_m_s2; }),
-      number<double>("max_imu_gap_s", [](auto* s) { return &s->stationary.max_gap_s; }),
-      number<double>("max_gyro_span_s", [](auto* s) { return &s->max_gyro_span_s; }),
+      number<double>(
+          "stationary_window_s", [](auto* s) { return &s->stationary.window_s; }, kPositive),
+      number<double>(
+          "min_stationary_duration_s", [](auto* s) { return &s->stationary.min_duration_s; },
+          kPositive),
+      number<double>(
+          "max_gyro_std_rad_s", [](auto* s) { return &s->stationary.max_gyro_std_rad_s; },
+          kPositive),
+      number<double>(
+          "max_accel_std_m_s2", [](auto* s) { return &s->stationary.max_accel_std_m_s2; },
+          kPositive),
+      number<double>(
+          "stationary_noise_factor", [](auto* s) { return &s->stationary.noise_factor; },
+          kNonNegative),
+      number<double>(
+          "max_gyro_change_rad_s", [](auto* s) { return &s->stationary.max_gyro_change_rad_s; },
+          kPositive),
+      number<double>(
+          "max_gravity_turn_rate_rad_s",
+          [](auto* s) { return &s->stationary.max_gravity_turn_rate_rad_s; }, kPositive),
+      number<double>(
+          "stationary_change_noise_factor",
+          [](auto* s) { return &s->stationary.change_noise_factor; }, kNonNegative),
+      number<double>(
+          "max_gyro_bias_rad_s", [](auto* s) { return &s->stationary.max_gyro_bias_rad_s; },
+          kPositive),
+      number<double>(
+          "max_rate_about_gravity_rad_s",
+          [](auto* s) { return &s->stationary.max_rate_about_gravity_rad_s; }, kPositive),
+      number<double>(
+          "max_gravity_error_m_s2", [](auto* s) { return &s->stationary.max_gravity_error_m_s2; },
+          kPositive),
+      number<double>(
+          "gravity_m_s2", [](auto* s) { return &s->stationary.gravity_m_s2; }, kPositive),
+      number<double>(
+          "max_imu_gap_s", [](auto* s) { return &s->stationary.max_gap_s; }, kPositive),
+      number<double>(
+          "max_gyro_span_s", [](auto* s) { return &s->max_gyro_span_s; }, kPositive),
       // IMU orientation.
       {"imu_orientation",
        [](const YAML::Node& node, PipelineSettings* s) {
          if (!parseImuOrientationSource(node.as<std::string>(), &s->imu_orientation)) {
-           throw YAML::Exception(node.Mark(),
-                                 "must be 'joint', 'auto', 'magnetometer' or 'message'");
+           throw YAML::Exception(node.Mark(), "unknown source");
          }
-       }},
-      number<double>("accel_weight", [](auto* s) { return &s->accel_weight; }),
+       },
+       "'joint', 'auto', 'magnetometer' or 'message'"},
+      number<double>(
+          "accel_weight", [](auto* s) { return &s->accel_weight; }, "a number within (0, 1)"),
       // Joint estimate: 1-sigma of the priors on the IMU's errors.
-      number<double>("imu_prior_gyro_scale", [](auto* s) { return &s->joint.priors.gyro_scale; }),
-      number<double>("imu_prior_gyro_cross_axis", [](auto* s) { return &s->joint.priors.gyro_cross_axis; }),
-      number<double>("imu_prior_gyro_bias_walk_rad_s_sqrt_s", [](auto* s) { return &s->joint.priors.gyro_bias_walk_rad_s_sqrt_s; }),
-      number<double>("imu_prior_accel_scale", [](auto* s) { return &s->joint.priors.accel_scale; }),
-      number<double>("imu_prior_accel_cross_axis", [](auto* s) { return &s->joint.priors.accel_cross_axis; }),
-      number<double>("imu_prior_accel_bias_m_s2", [](auto* s) { return &s->joint.priors.accel_bias_m_s2; }),
-      number<double>("imu_prior_soft_iron_scale", [](auto* s) { return &s->joint.priors.soft_iron_scale; }),
-      number<double>("imu_prior_soft_iron_cross", [](auto* s) { return &s->joint.priors.soft_iron_cross; }),
-      number<double>("imu_prior_hard_iron_t", [](auto* s) { return &s->joint.priors.hard_iron_t; }),
+      number<double>(
+          "imu_prior_gyro_scale", [](auto* s) { return &s->joint.priors.gyro_scale; }, kPositive),
+      number<double>(
+          "imu_prior_gyro_cross_axis", [](auto* s) { return &s->joint.priors.gyro_cross_axis; },
+          kPositive),
+      number<double>(
+          "imu_prior_gyro_bias_walk_rad_s_sqrt_s",
+          [](auto* s) { return &s->joint.priors.gyro_bias_walk_rad_s_sqrt_s; }, kPositive),
+      number<double>(
+          "imu_prior_accel_scale", [](auto* s) { return &s->joint.priors.accel_scale; }, kPositive),
+      number<double>(
+          "imu_prior_accel_cross_axis", [](auto* s) { return &s->joint.priors.accel_cross_axis; },
+          kPositive),
+      number<double>(
+          "imu_prior_accel_bias_m_s2", [](auto* s) { return &s->joint.priors.accel_bias_m_s2; },
+          kPositive),
+      number<double>(
+          "imu_prior_soft_iron_scale", [](auto* s) { return &s->joint.priors.soft_iron_scale; },
+          kPositive),
+      number<double>(
+          "imu_prior_soft_iron_cross", [](auto* s) { return &s->joint.priors.soft_iron_cross; },
+          kPositive),
+      number<double>(
+          "imu_prior_hard_iron_t", [](auto* s) { return &s->joint.priors.hard_iron_t; }, kPositive),
       // Magnetometer.
-      number<double>("mag_scale", [](auto* s) { return &s->magnetometer.scale; }),
+      number<double>(
+          "mag_scale", [](auto* s) { return &s->magnetometer.scale; }, kPositive),
       {"mag_hard_iron_t",
        [](const YAML::Node& node, PipelineSettings* s) {
          const auto v = node.as<std::vector<double>>();
          if (v.size() != 3) throw YAML::Exception(node.Mark(), "needs 3 numbers (T)");
          s->magnetometer.hard_iron_t = Eigen::Vector3d(v[0], v[1], v[2]);
-       }},
+       },
+       "a list of 3 finite numbers (tesla)"},
       {"mag_soft_iron",
        [](const YAML::Node& node, PipelineSettings* s) {
          const auto v = node.as<std::vector<double>>();
          if (v.size() != 9) throw YAML::Exception(node.Mark(), "needs 9 numbers (row-major 3x3)");
          for (int i = 0; i < 9; ++i) s->magnetometer.soft_iron(i / 3, i % 3) = v[i];
-       }},
-      number<double>("mag_max_norm_change",
-                     [](auto* s) { return &s->disturbance.max_norm_change; }),
-      number<double>("mag_max_dip_change_deg",
-                     [](auto* s) { return &s->disturbance.max_dip_change_deg; }),
-      number<double>("mag_max_scatter_deg",
-                     [](auto* s) { return &s->disturbance.max_within_segment_std_deg; }),
+       },
+       "a list of 9 finite numbers, an invertible row-major 3x3 matrix"},
+      number<double>(
+          "mag_max_norm_change", [](auto* s) { return &s->disturbance.max_norm_change; },
+          kPositive),
+      number<double>(
+          "mag_max_dip_change_deg", [](auto* s) { return &s->disturbance.max_dip_change_deg; },
+          kPositive),
+      number<double>(
+          "mag_max_scatter_deg", [](auto* s) { return &s->disturbance.max_within_segment_std_deg; },
+          kPositive),
       // Camera.
-      number<int>("min_target_points", [](auto* s) { return &s->detector.min_points; }),
-      number<double>("max_reprojection_rms_px",
-                     [](auto* s) { return &s->pose.max_reprojection_rms_px; }),
-      number<double>("min_ambiguity_ratio", [](auto* s) { return &s->pose.min_ambiguity_ratio; }),
-      number<int>("min_frames_per_pose", [](auto* s) { return &s->min_frames_per_pose; }),
-      number<int>("max_frames_per_pose", [](auto* s) { return &s->max_frames_per_pose; }),
-      number<double>("min_frame_interval_s", [](auto* s) { return &s->min_frame_interval_s; }),
-      number<double>("missed_frame_interval_s",
-                     [](auto* s) { return &s->missed_frame_interval_s; }),
-      number<double>("frame_margin_s", [](auto* s) { return &s->frame_margin_s; }),
-      number<double>("max_camera_spread_deg", [](auto* s) { return &s->max_camera_spread_deg; }),
-      number<double>("frame_queue_s", [](auto* s) { return &s->frame_queue_s; }),
+      number<int>(
+          "min_target_points", [](auto* s) { return &s->detector.min_points; }, "an integer >= 4"),
+      number<double>(
+          "max_reprojection_rms_px", [](auto* s) { return &s->pose.max_reprojection_rms_px; },
+          kPositive),
+      number<double>(
+          "min_ambiguity_ratio", [](auto* s) { return &s->pose.min_ambiguity_ratio; }, kPositive),
+      number<int>(
+          "min_frames_per_pose", [](auto* s) { return &s->min_frames_per_pose; },
+          "an integer within [1, max_frames_per_pose]"),
+      number<int>(
+          "max_frames_per_pose", [](auto* s) { return &s->max_frames_per_pose; },
+          "an integer >= min_frames_per_pose"),
+      number<double>(
+          "min_frame_interval_s", [](auto* s) { return &s->min_frame_interval_s; }, kNonNegative),
+      number<double>(
+          "missed_frame_interval_s", [](auto* s) { return &s->missed_frame_interval_s; },
+          "a finite number >= min_frame_interval_s"),
+      number<double>(
+          "frame_margin_s", [](auto* s) { return &s->frame_margin_s; }, kNonNegative),
+      number<double>(
+          "max_camera_spread_deg", [](auto* s) { return &s->max_camera_spread_deg; }, kPositive),
+      number<double>(
+          "frame_queue_s", [](auto* s) { return &s->frame_queue_s; }, kPositive),
       // Window and solver.
-      number<std::size_t>("window_poses", [](auto* s) { return &s->window_poses; }),
-      number<int>("min_poses_to_solve", [](auto* s) { return &s->min_poses_to_solve; }),
+      number<std::size_t>(
+          "window_poses", [](auto* s) { return &s->window_poses; }, "an integer within [2, 200]"),
+      number<int>(
+          "min_poses_to_solve", [](auto* s) { return &s->min_poses_to_solve; },
+          "an integer within [2, window_poses]"),
       {"solver_method",
        [](const YAML::Node& node, PipelineSettings* s) {
          if (!parseSolverMethod(node.as<std::string>(), &s->solver.method)) {
-           throw YAML::Exception(node.Mark(), "must be 'optimal' or 'two_step'");
+           throw YAML::Exception(node.Mark(), "unknown method");
          }
-       }},
-      number<int>("two_step_max_iterations",
-                  [](auto* s) { return &s->solver.two_step.max_iterations; }),
+       },
+       "'optimal' or 'two_step'"},
+      number<int>(
+          "two_step_max_iterations", [](auto* s) { return &s->solver.two_step.max_iterations; },
+          "an integer >= 1"),
   };
   return table;
 }
@@ -128,14 +185,16 @@ void readPipelineKey(const std::string& source, const std::string& name, const Y
   if (!key) throw InputError(source + ": unknown key '" + name + "' (see config/default.yaml)");
   try {
     key->read(value, settings);
-  } catch (const YAML::Exception& e) {
-    throw InputError(source + ": key '" + name + "': " + e.msg);
+  } catch (const YAML::Exception&) {
+    throw InputError(badValueMessage(source, name, yamlText(value), key->allowed));
   }
 }
 
 void checkPipelineSettings(const std::string& source, const PipelineSettings& settings) {
   if (settings.solver.two_step.max_iterations < 1) {
-    throw InputError(source + ": key 'two_step_max_iterations' must be >= 1");
+    throw InputError(badValueMessage(source, "two_step_max_iterations",
+                                     std::to_string(settings.solver.two_step.max_iterations),
+                                     "an integer >= 1"));
   }
   const std::string error = settings.validate();
   if (!error.empty()) throw InputError(source + ": " + error);

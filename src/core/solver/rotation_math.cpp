@@ -2,6 +2,8 @@
 
 #include <Eigen/SVD>
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 
 namespace camera_imu_alignment {
 namespace {
@@ -191,6 +193,15 @@ Eigen::Vector3d rollPitchYawDeg(const Eigen::Matrix3d& R) {
     yaw = std::atan2(-R(0, 1), R(1, 1));
   }
   return Eigen::Vector3d(rad2deg(roll), rad2deg(pitch), rad2deg(yaw));
+}
+
+std::string rollPitchYawText(const Eigen::Matrix3d& R, int decimals) {
+  const Eigen::Vector3d rpy = rollPitchYawDeg(R);
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(decimals)
+      << "roll, pitch, yaw (deg, R = Rz(yaw) Ry(pitch) "
+      << "Rx(roll)): [" << rpy.x() << ", " << rpy.y() << ", " << rpy.z() << "]";
+  return out.str();
 }
 
 }  // namespace camera_imu_alignment
