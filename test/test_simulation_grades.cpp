@@ -115,16 +115,16 @@ TEST(SimulationGrades, AtRestAccelerometerIsTaTimesGravityPlusBiasAndMagnetomete
           6.0 * e.noise.accelerometer_noise_density * std::sqrt(c.imu_rate_hz / na);
       const double field_tol = 6.0 * e.noise.magnetometer_noise_sigma / std::sqrt(nm);
       EXPECT_LT((accel - e.T_a * up_imu).cwiseAbs().maxCoeff(), accel_tol)
-          << imuGradeName(grade) << " pose start " << p.start_s;
+          << toString(grade) << " pose start " << p.start_s;
       const Eigen::Vector3d field_model =
           e.mag_soft_iron * R_world_imu.transpose() * c.earth_field_world + e.mag_hard_iron;
-      EXPECT_LT((field - field_model).cwiseAbs().maxCoeff(), field_tol) << imuGradeName(grade);
+      EXPECT_LT((field - field_model).cwiseAbs().maxCoeff(), field_tol) << toString(grade);
       max_error_vs_ideal_model =
           std::max(max_error_vs_ideal_model, (accel - up_imu).cwiseAbs().maxCoeff() / accel_tol);
     }
     // The systematic errors are larger than the noise: a model without T_a does not fit.
     if (grade != ImuGrade::kIdeal) {
-      EXPECT_GT(max_error_vs_ideal_model, 2.0) << imuGradeName(grade);
+      EXPECT_GT(max_error_vs_ideal_model, 2.0) << toString(grade);
     }
   }
 }
@@ -163,7 +163,7 @@ TEST(SimulationGrades, GyroIntegralOverAMotionIsTheIntegralOfTgOmegaPlusBias) {
       const double tol =
           6.0 * run.imu_errors.noise.gyroscope_noise_density * std::sqrt(g.samples * dt);
       EXPECT_LT((g.measured - g.model).cwiseAbs().maxCoeff(), tol)
-          << imuGradeName(grade) << " motion " << k;
+          << toString(grade) << " motion " << k;
       EXPECT_GT(g.plain.norm(), 0.1) << "the rig turns during the motion";
     }
     // Without noise the gyro is exactly T_g w, and for a real grade that is not w.
@@ -171,14 +171,14 @@ TEST(SimulationGrades, GyroIntegralOverAMotionIsTheIntegralOfTgOmegaPlusBias) {
     const SimulationRun clean(c);
     for (size_t k = 0; k + 1 < clean.trajectory.poses().size(); ++k) {
       const GyroIntegrals g = integrateMotion(clean, k);
-      EXPECT_LT((g.measured - g.model).norm(), 1e-12) << imuGradeName(grade);
+      EXPECT_LT((g.measured - g.model).norm(), 1e-12) << toString(grade);
       if (grade == ImuGrade::kIdeal) {
         EXPECT_LT((g.measured - g.plain).norm(), 1e-12);
       } else {
         // At least the gyro's scale/misalignment spread times the turned angle, within a factor 5.
         const double sigma = clean.config.imu_systematic.gyro_cross_axis_sigma;
         EXPECT_GT((g.measured - g.plain).norm(), 0.2 * sigma * g.plain.norm())
-            << imuGradeName(grade) << " motion " << k;
+            << toString(grade) << " motion " << k;
       }
     }
   }
@@ -239,7 +239,7 @@ TEST(SimulationGrades, DrawnErrorsHaveTheGradesSpreadOver200Seeds) {
     for (const auto& check : checks) {
       ASSERT_GT(check.sigma, 0.0) << check.name;
       EXPECT_NEAR(stddev(check.values) / check.sigma, 1.0, 0.3)
-          << imuGradeName(grade) << " " << check.name;
+          << toString(grade) << " " << check.name;
     }
   }
   // The grades' headline numbers (datasheet table in imu_grades.cpp).
@@ -313,7 +313,7 @@ TEST(SimulationGrades, ScenariosAndNamesSelectTheGrades) {
   }
   for (ImuGrade g : kAllGrades) {
     ImuGrade parsed = ImuGrade::kIdeal;
-    ASSERT_TRUE(parseImuGrade(imuGradeName(g), &parsed));
+    ASSERT_TRUE(parseImuGrade(toString(g), &parsed));
     EXPECT_EQ(parsed, g);
   }
   ImuGrade untouched = ImuGrade::kNoisy;

@@ -134,7 +134,7 @@ const std::vector<std::pair<std::string, std::string>>& imuGradeList() {
   return list;
 }
 
-const char* imuGradeName(ImuGrade grade) {
+const char* toString(ImuGrade grade) {
   switch (grade) {
     case ImuGrade::kTactical:
       return "tactical";
@@ -150,7 +150,7 @@ const char* imuGradeName(ImuGrade grade) {
 bool parseImuGrade(const std::string& name, ImuGrade* grade) {
   for (ImuGrade g :
        {ImuGrade::kIdeal, ImuGrade::kTactical, ImuGrade::kConsumer, ImuGrade::kNoisy}) {
-    if (name == imuGradeName(g)) {
+    if (name == toString(g)) {
       *grade = g;
       return true;
     }

@@ -153,7 +153,7 @@ std::string validateConfig(const SimulationConfig& c) {
   return s;
 }
 
-const char* targetTypeName(TargetType type) {
+const char* toString(TargetType type) {
   switch (type) {
     case TargetType::kAprilgrid:
       return "aprilgrid";
@@ -164,7 +164,7 @@ const char* targetTypeName(TargetType type) {
   }
 }
 
-const char* motionKindName(MotionKind kind) {
+const char* toString(MotionKind kind) {
   switch (kind) {
     case MotionKind::kSingleAxis:
       return "single_axis";

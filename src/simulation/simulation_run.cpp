@@ -92,7 +92,7 @@ void imuErrorsYaml(const ImuErrors& e, const ImuSystematicSigmas& sigmas, Writer
     << "imu_errors:  # drawn once per seed; gyro = T_g w + b_g(t) + n_g, accel = T_a f + b_a(t) + "
        "n_a,\n"
        "            # mag = S (R_world_imu^T B) + h + n_m (IMU frame = the accelerometer's)\n"
-    << "  grade: " << imuGradeName(e.grade) << "\n  T_g: ";
+    << "  grade: " << toString(e.grade) << "\n  T_g: ";
   w->matrix(e.T_g);
   o << "  # gyro scale (diagonal) and cross-axis/misalignment\n  T_a: ";
   w->matrix(e.T_a);
@@ -172,7 +172,7 @@ std::string truthYaml(const SimulationRun& run) {
   o << "duration_s: " << tr.duration() << "\n";
   o << "gravity_world: ";
   w.vec(c.gravity_world);
-  o << "  # m/s^2, ENU\nmotion: " << motionKindName(c.motion) << "\n";
+  o << "  # m/s^2, ENU\nmotion: " << toString(c.motion) << "\n";
   o << "stationary_intervals:  # [start_s, end_s], bag time\n" << std::setprecision(16);
   for (const StationaryPose& p : tr.poses())
     o << "  - [" << t0 + p.start_s << ", " << t0 + p.end_s << "]\n";
@@ -193,7 +193,7 @@ std::string truthYaml(const SimulationRun& run) {
     o << "\n";
   }
   o << "target:  # pose of the target frame in the world (see the target YAML)\n  type: "
-    << targetTypeName(c.target.type) << "\n  R_world_target:\n";
+    << toString(c.target.type) << "\n  R_world_target:\n";
   w.rotation("    ", tr.R_world_target());
   o << "  p_world_target_m: ";
   w.vec(tr.p_world_target());

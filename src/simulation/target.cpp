@@ -158,7 +158,7 @@ std::string targetYaml(const TargetSpec& t) {
   std::ostringstream o;
   o << std::setprecision(12);
   o << "# Kalibr calibration target, written by camera_imu_alignment simulate_bag\n";
-  o << "target_type: '" << targetTypeName(t.type) << "'\n";
+  o << "target_type: '" << toString(t.type) << "'\n";
   switch (t.type) {
     case TargetType::kAprilgrid:
       o << "tagCols: " << t.cols << "\ntagRows: " << t.rows << "\ntagSize: " << t.spacing_m

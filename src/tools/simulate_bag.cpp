@@ -233,7 +233,7 @@ sim::SimulationConfig configFromArgs(const cia::CliArgs& a) {
       throw cia::UsageError("--target must be checkerboard, aprilgrid or circlegrid, got '" + t +
                             "'");
     }
-    if (t != sim::targetTypeName(c.target.type)) {
+    if (t != sim::toString(c.target.type)) {
       sim::SimulationConfig preset;  // the default target of that type
       sim::applyScenario(t == "checkerboard" ? "nominal" : t, &preset);
       c.target = preset.target;

@@ -58,7 +58,7 @@ struct ImuGradeSpec {
 /// Grade names ("ideal", "tactical", "consumer", "noisy") with a one-line description, in order.
 const std::vector<std::pair<std::string, std::string>>& imuGradeList();
 
-const char* imuGradeName(ImuGrade grade);
+const char* toString(ImuGrade grade);
 
 /// False (and `grade` untouched) for an unknown name.
 bool parseImuGrade(const std::string& name, ImuGrade* grade);

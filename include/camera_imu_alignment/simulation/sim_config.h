@@ -110,8 +110,8 @@ bool applyScenario(const std::string& name, SimulationConfig* config);
 /// Checks every setting; returns an empty string when usable, else a message naming the setting.
 std::string validateConfig(const SimulationConfig& config);
 
-const char* targetTypeName(TargetType type);
-const char* motionKindName(MotionKind kind);
+const char* toString(TargetType type);
+const char* toString(MotionKind kind);
 
 }  // namespace simulation
 }  // namespace camera_imu_alignment
