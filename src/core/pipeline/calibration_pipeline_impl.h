@@ -19,6 +19,14 @@ struct FrameDetection {
   CameraPose pose;
 };
 
+/// The magnetometer over one rest (pose_assembly.cpp).
+struct SegmentField {
+  int count = 0;
+  Eigen::Vector3d mean_t = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d mean_cov_t2 = Eigen::Matrix3d::Zero();  ///< covariance of the mean (scatter / N)
+  double scatter_deg = 0.0;
+};
+
 struct CalibrationPipeline::Impl {
   Impl(const TargetDescription& target, const PipelineSettings& settings,
        PipelineCallbacks callbacks);
@@ -82,7 +90,7 @@ struct CalibrationPipeline::Impl {
   /// A stationary segment ended: build the pose (pose_assembly.cpp) in these steps.
   void onSegment(const StationarySegment& segment);
   /// The rest's mean field: sets magnetometer_usable / R_world_imu_accel_mag or the note why not.
-  void assessMagnetometer(const StationarySegment& segment, StationaryPose* pose);
+  SegmentField assessMagnetometer(const StationarySegment& segment, StationaryPose* pose);
   /// The gyro rotation since the previous rest (R_imu_previous_imu_gyro) and its difference to
   /// the accelerometer + magnetometer one.
   void integrateGyroSincePrevious(const StationarySegment& segment, StationaryPose* pose) const;
@@ -94,8 +102,8 @@ struct CalibrationPipeline::Impl {
   void acceptPose(const StationaryPose& pose, JointWindow::Entry joint_entry);
   /// The rest's measurements for the joint estimate (before the buffers move on); advances
   /// joint_gyro_pending by the gyro samples since the previous rest.
-  JointWindow::Entry jointMeasurements(const StationarySegment& segment,
-                                       const StationaryPose& pose);
+  JointWindow::Entry jointMeasurements(const StationarySegment& segment, const StationaryPose& pose,
+                                       const SegmentField& field);
   void solveAndReport();
   AlignmentResult solve() const;
 };

@@ -49,36 +49,13 @@ RestStatistics restStatistics(const std::deque<ImuSample>& samples, double start
   return stats;
 }
 
-std::optional<std::pair<Eigen::Vector3d, Eigen::Matrix3d>> fieldStatistics(
-    const std::deque<MagneticSample>& samples, double start_s, double end_s, int min_count) {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  int n = 0;
-  for (const MagneticSample& s : samples) {
-    if (s.stamp_s < start_s || s.stamp_s > end_s) continue;
-    sum += s.field_t;
-    ++n;
-  }
-  if (n < std::max(2, min_count)) return std::nullopt;
-  const Eigen::Vector3d mean = sum / n;
-  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-  for (const MagneticSample& s : samples) {
-    if (s.stamp_s < start_s || s.stamp_s > end_s) continue;
-    const Eigen::Vector3d d = s.field_t - mean;
-    scatter += d * d.transpose();
-  }
-  return std::make_pair(mean, Eigen::Matrix3d(scatter / (static_cast<double>(n - 1) * n)));
-}
-
-GyroSegment gyroSamplesBetween(const std::deque<ImuSample>& samples, double from_s, double to_s,
-                               double noise_density_rad_s_sqrt_hz) {
-  GyroSegment segment;
-  segment.noise_density_rad_s_sqrt_hz = noise_density_rad_s_sqrt_hz;
+void appendGyroSamples(const std::deque<ImuSample>& samples, double from_s, double to_s,
+                       GyroSegment* segment) {
   for (const ImuSample& s : samples) {
     if (s.stamp_s < from_s || s.stamp_s > to_s) continue;
-    segment.stamps_s.push_back(s.stamp_s);
-    segment.gyro_rad_s.push_back(s.gyro_rad_s);
+    segment->stamps_s.push_back(s.stamp_s);
+    segment->gyro_rad_s.push_back(s.gyro_rad_s);
   }
-  return segment;
 }
 
 void JointWindow::add(Entry entry) {

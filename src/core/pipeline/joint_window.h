@@ -27,14 +27,9 @@ struct RestStatistics {
 /// Statistics of the samples with stamps in [start_s, end_s] (count 0 when fewer than 2).
 RestStatistics restStatistics(const std::deque<ImuSample>& samples, double start_s, double end_s);
 
-/// Mean field and covariance of the mean (T, T^2) of the samples in [start_s, end_s]; nullopt when
-/// fewer than `min_count`.
-std::optional<std::pair<Eigen::Vector3d, Eigen::Matrix3d>> fieldStatistics(
-    const std::deque<MagneticSample>& samples, double start_s, double end_s, int min_count);
-
-/// The raw gyro samples with stamps in [from_s, to_s], as a GyroSegment (indices unset).
-GyroSegment gyroSamplesBetween(const std::deque<ImuSample>& samples, double from_s, double to_s,
-                               double noise_density_rad_s_sqrt_hz);
+/// Appends the raw gyro samples with stamps in [from_s, to_s] to `segment`.
+void appendGyroSamples(const std::deque<ImuSample>& samples, double from_s, double to_s,
+                       GyroSegment* segment);
 
 /// The joint estimator's view of the window: one entry per pose, oldest first.
 class JointWindow {

@@ -16,12 +16,6 @@ namespace {
 
 /// The field of a segment: mean of the samples inside it and how much its direction wandered
 /// (fieldDirectionScatterDeg).
-struct SegmentField {
-  int count = 0;
-  Eigen::Vector3d mean_t = Eigen::Vector3d::Zero();
-  double scatter_deg = 0.0;
-};
-
 SegmentField segmentField(const std::deque<MagneticSample>& samples, double start_s, double end_s) {
   SegmentField field;
   std::vector<Eigen::Vector3d> inside;
@@ -34,6 +28,12 @@ SegmentField segmentField(const std::deque<MagneticSample>& samples, double star
   if (field.count == 0) return field;
   field.mean_t /= field.count;
   field.scatter_deg = fieldDirectionScatterDeg(inside);
+  if (field.count >= 2) {
+    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    for (const Eigen::Vector3d& f : inside)
+      scatter += (f - field.mean_t) * (f - field.mean_t).transpose();
+    field.mean_cov_t2 = scatter / (static_cast<double>(field.count - 1) * field.count);
+  }
   return field;
 }
 
@@ -123,9 +123,9 @@ void CalibrationPipeline::Impl::onSegment(const StationarySegment& segment) {
   pose.start_s = segment.start_s;
   pose.end_s = segment.end_s;
   pose.gyro_bias_rad_s = segment.gyro_bias_rad_s;
-  assessMagnetometer(segment, &pose);
+  const SegmentField field = assessMagnetometer(segment, &pose);
   integrateGyroSincePrevious(segment, &pose);
-  JointWindow::Entry joint_entry = jointMeasurements(segment, pose);
+  JointWindow::Entry joint_entry = jointMeasurements(segment, pose, field);
   chooseImuOrientation(segment, &pose);
   const std::string rejection = assessCamera(segment, &pose);
   if (!rejection.empty()) {
@@ -138,7 +138,8 @@ void CalibrationPipeline::Impl::onSegment(const StationarySegment& segment) {
 }
 
 JointWindow::Entry CalibrationPipeline::Impl::jointMeasurements(const StationarySegment& segment,
-                                                                const StationaryPose& pose) {
+                                                                const StationaryPose& pose,
+                                                                const SegmentField& field) {
   JointWindow::Entry entry;
   JointPose& jp = entry.pose;
   jp.start_s = segment.start_s;
@@ -153,12 +154,9 @@ JointWindow::Entry CalibrationPipeline::Impl::jointMeasurements(const Stationary
     jp.accel_mean_m_s2 = segment.mean_accel_m_s2;
     jp.gyro_mean_rad_s = segment.gyro_bias_rad_s;
   }
-  if (pose.magnetometer_usable) {
-    if (const auto field =
-            fieldStatistics(mag_buffer, segment.start_s, segment.end_s, kMinFieldSamples)) {
-      jp.mag_mean_t = field->first;
-      jp.mag_mean_cov = field->second;
-    }
+  if (pose.magnetometer_usable) {  // at least kMinFieldSamples samples
+    jp.mag_mean_t = field.mean_t;
+    jp.mag_mean_cov = field.mean_cov_t2;
   }
   // The gyro since the previous rest: linked only while the chain holds (the same coverage test
   // as the gyro chain's integration).
@@ -166,21 +164,12 @@ JointWindow::Entry CalibrationPipeline::Impl::jointMeasurements(const Stationary
   if (!pose.R_imu_previous_imu_gyro) {
     joint_gyro_pending.reset();
   } else if (joint_gyro_pending) {
-    const GyroSegment chunk =
-        gyroSamplesBetween(imu_buffer, chain_segment.end_s, segment.start_s, density);
-    joint_gyro_pending->stamps_s.insert(joint_gyro_pending->stamps_s.end(), chunk.stamps_s.begin(),
-                                        chunk.stamps_s.end());
-    joint_gyro_pending->gyro_rad_s.insert(joint_gyro_pending->gyro_rad_s.end(),
-                                          chunk.gyro_rad_s.begin(), chunk.gyro_rad_s.end());
+    appendGyroSamples(imu_buffer, chain_segment.end_s, segment.start_s, &*joint_gyro_pending);
     joint_gyro_pending->noise_density_rad_s_sqrt_hz =
         std::max(joint_gyro_pending->noise_density_rad_s_sqrt_hz, density);
     entry.gyro_from_previous = joint_gyro_pending;
     // Should this rest become no pose, its own samples join the motion to the next pose.
-    const GyroSegment own = gyroSamplesBetween(imu_buffer, segment.start_s, segment.end_s, density);
-    joint_gyro_pending->stamps_s.insert(joint_gyro_pending->stamps_s.end(), own.stamps_s.begin(),
-                                        own.stamps_s.end());
-    joint_gyro_pending->gyro_rad_s.insert(joint_gyro_pending->gyro_rad_s.end(),
-                                          own.gyro_rad_s.begin(), own.gyro_rad_s.end());
+    appendGyroSamples(imu_buffer, segment.start_s, segment.end_s, &*joint_gyro_pending);
     const auto& stamps = joint_gyro_pending->stamps_s;
     if (!stamps.empty() && stamps.back() - stamps.front() > settings.max_gyro_span_s) {
       joint_gyro_pending.reset();  // as long a motion breaks the gyro chain too
@@ -192,15 +181,15 @@ JointWindow::Entry CalibrationPipeline::Impl::jointMeasurements(const Stationary
   return entry;
 }
 
-void CalibrationPipeline::Impl::assessMagnetometer(const StationarySegment& segment,
-                                                   StationaryPose* pose) {
+SegmentField CalibrationPipeline::Impl::assessMagnetometer(const StationarySegment& segment,
+                                                           StationaryPose* pose) {
   // Usable when there are samples, the attitude is defined and the field is undisturbed.
   const SegmentField field = segmentField(mag_buffer, segment.start_s, segment.end_s);
   if (field.count < kMinFieldSamples) {
     pose->magnetometer_note = field.count == 0 && num_mag == 0
                                   ? "no magnetometer data"
                                   : "only " + std::to_string(field.count) + " field samples";
-    return;
+    return field;
   }
   const AttitudeFromVectors attitude =
       attitudeFromAccelMag(segment.mean_accel_m_s2, field.mean_t, settings.accel_weight);
@@ -213,6 +202,7 @@ void CalibrationPipeline::Impl::assessMagnetometer(const StationarySegment& segm
     pose->magnetometer_usable = true;
     pose->R_world_imu_accel_mag = attitude.R_world_imu;
   }
+  return field;
 }
 
 void CalibrationPipeline::Impl::integrateGyroSincePrevious(const StationarySegment& segment,
