@@ -15,7 +15,7 @@ export ROS_HOME="${WS}/ros_home"
 
 CIA_PACKAGES=(
   build-essential cmake catkin ros-base-dev rosbash python3-rostest python3-rosbag
-  libeigen3-dev libceres-dev libopencv-dev libopencv-contrib-dev libyaml-cpp-dev libgtest-dev libbenchmark-dev
+  libeigen3-dev libboost-dev libceres-dev libopencv-dev libopencv-contrib-dev libyaml-cpp-dev libgtest-dev libbenchmark-dev
   librosbag-dev libsensor-msgs-dev libstd-msgs-dev libgeometry-msgs-dev libstd-srvs-dev
   libnodelet-dev libimage-transport-dev libtf2-dev libtf2-msgs-dev libtf2-ros-dev
   libdiagnostic-updater-dev libdiagnostic-msgs-dev tf2-tools libcv-bridge-dev libtf2-eigen-dev

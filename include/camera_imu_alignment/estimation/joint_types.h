@@ -49,6 +49,11 @@ struct GyroSegment {
 struct JointProblem {
   std::vector<JointPose> poses;
   std::vector<GyroSegment> segments;
+  /// A mount change (the change-point model of mount_change.h): poses from this index on have
+  /// their own R_cam_imu (JointResult::R_cam_imu_after_change), the IMU's parameters stay shared,
+  /// and the gyro segment into this pose (the motion during which the mount moved) is not used.
+  /// -1: one mount for all poses.
+  int mount_change_pose = -1;
 };
 
 /// 1-sigma of the Gaussian priors on the IMU parameters (mean: the ideal sensor, T = I, bias 0).
@@ -166,6 +171,9 @@ struct JointResult {
   Eigen::Matrix3d covariance_rad2 = Eigen::Matrix3d::Zero();
   Eigen::Vector3d std_dev_deg = Eigen::Vector3d::Zero();  ///< camera x, y, z axes
   double covariance_scale = 1.0;  ///< chi2 / dof applied to every covariance (1 when <= 1)
+  /// With JointProblem::mount_change_pose: R_cam_imu of the poses from that index on (R_cam_imu
+  /// is then the earlier poses').
+  std::optional<Eigen::Matrix3d> R_cam_imu_after_change;
   Eigen::Matrix3d R_world_target =
       Eigen::Matrix3d::Identity();  ///< W's yaw: gauge w/o magnetometer
   ImuIntrinsics intrinsics;

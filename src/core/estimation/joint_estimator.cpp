@@ -170,6 +170,7 @@ JointResult JointEstimator::solve(const JointProblem& problem,
   }
 
   result.R_cam_imu = state.R_cam_imu_0;
+  if (problem.mount_change_pose >= 0) result.R_cam_imu_after_change = state.R_cam_imu_after_0;
   result.R_world_target = state.R_world_target_0;
   if (!isRotationMatrix(result.R_cam_imu, 1e-6) || !result.covariance_rad2.allFinite()) {
     result.message = "the estimate is not finite";

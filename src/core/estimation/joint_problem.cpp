@@ -52,6 +52,7 @@ class Builder {
   BuiltProblem build(const std::vector<GyroPreintegration>& gyro) {
     const size_t n = problem_.poses.size();
     addBlock(state_.e_X.data(), 3);
+    if (problem_.mount_change_pose >= 0) addBlock(state_.e_X_after.data(), 3);
     addBlock(state_.e_T.data(), 3);
     // Without the magnetometer, W's yaw is a gauge: hold the increment about world z.
     if (!observability_.magnetometer_used) {
@@ -81,6 +82,17 @@ class Builder {
     built_.residuals.push_back({id, pose, other_pose, size});
   }
 
+  bool afterChange(size_t k) const {
+    return problem_.mount_change_pose >= 0 && static_cast<int>(k) >= problem_.mount_change_pose;
+  }
+  /// R_cam_imu of pose k: its linearisation point and increment block.
+  const Eigen::Matrix3d& cameraImu0(size_t k) const {
+    return afterChange(k) ? state_.R_cam_imu_after_0 : state_.R_cam_imu_0;
+  }
+  double* cameraImuIncrement(size_t k) {
+    return afterChange(k) ? state_.e_X_after.data() : state_.e_X.data();
+  }
+
   Eigen::Matrix3d targetCam(size_t k) const {
     return state_.R_world_target_0 * projectToSO3(problem_.poses[k].R_target_cam);
   }
@@ -90,11 +102,10 @@ class Builder {
     addBlock(state_.accel_bias.data(), 3);
     for (size_t k = 0; k < problem_.poses.size(); ++k) {
       const JointPose& pose = problem_.poses[k];
-      auto* accel =
-          new ceres::AutoDiffCostFunction<AccelResidual, 3, 3, 3, 3, 6, 3>(new AccelResidual{
-              targetCam(k), state_.R_cam_imu_0, pose.accel_mean_m_s2, whitening_.accel[k],
-              settings_.gravity_m_s2, settings_.accel_matrix_form});
-      record(ceres_.AddResidualBlock(accel, loss_, state_.e_T.data(), state_.e_X.data(),
+      auto* accel = new ceres::AutoDiffCostFunction<AccelResidual, 3, 3, 3, 3, 6, 3>(
+          new AccelResidual{targetCam(k), cameraImu0(k), pose.accel_mean_m_s2, whitening_.accel[k],
+                            settings_.gravity_m_s2, settings_.accel_matrix_form});
+      record(ceres_.AddResidualBlock(accel, loss_, state_.e_T.data(), cameraImuIncrement(k),
                                      state_.delta[k].data(), state_.accel_matrix.data(),
                                      state_.accel_bias.data()),
              static_cast<int>(k), -1, 3);
@@ -131,9 +142,9 @@ class Builder {
       const JointPose& pose = problem_.poses[k];
       if (!pose.mag_mean_t) continue;
       auto* mag = new ceres::AutoDiffCostFunction<MagResidual, 3, 3, 3, 3, 6, 3, 2>(
-          new MagResidual{targetCam(k), state_.R_cam_imu_0, *pose.mag_mean_t * kMicroteslaPerTesla,
+          new MagResidual{targetCam(k), cameraImu0(k), *pose.mag_mean_t * kMicroteslaPerTesla,
                           whitening_.mag_ut[k]});
-      record(ceres_.AddResidualBlock(mag, loss_, state_.e_T.data(), state_.e_X.data(),
+      record(ceres_.AddResidualBlock(mag, loss_, state_.e_T.data(), cameraImuIncrement(k),
                                      state_.delta[k].data(), state_.soft_iron.data(),
                                      state_.hard_iron_ut.data(), state_.field_ut.data()),
              static_cast<int>(k), -1, 3);
@@ -187,6 +198,8 @@ class Builder {
     for (size_t j = 0; j < problem_.segments.size(); ++j) {
       const GyroSegment& segment = problem_.segments[j];
       const int from = segment.from_pose, to = segment.to_pose;
+      // The mount moved during this motion: the camera and the IMU rotated differently.
+      if (afterChange(static_cast<size_t>(to)) && !afterChange(static_cast<size_t>(from))) continue;
       GyroModelVector theta0_minus_identity = gyro[j].theta0;
       theta0_minus_identity(0) -= 1.0;
       theta0_minus_identity(4) -= 1.0;
@@ -195,13 +208,14 @@ class Builder {
           projectToSO3(problem_.poses[from].R_target_cam).transpose() *
           projectToSO3(problem_.poses[to].R_target_cam);
       auto* cost = new ceres::AutoDiffCostFunction<GyroResidual, 3, 3, 3, 3, 9, 3, 3>(
-          new GyroResidual{quaternionOf(camera_relative), quaternionOf(state_.R_cam_imu_0),
+          new GyroResidual{quaternionOf(camera_relative), quaternionOf(cameraImu0(from)),
                            quaternionOf(gyro[j].delta_R), gyro[j].jacobian, theta0_minus_identity,
                            whitening_.gyro_relative[j]});
-      record(ceres_.AddResidualBlock(cost, loss_, state_.e_X.data(), state_.delta[from].data(),
-                                     state_.delta[to].data(), state_.gyro_matrix.data(),
-                                     state_.gyro_bias[from].data(), state_.gyro_bias[to].data()),
-             from, to, 3);
+      record(
+          ceres_.AddResidualBlock(cost, loss_, cameraImuIncrement(from), state_.delta[from].data(),
+                                  state_.delta[to].data(), state_.gyro_matrix.data(),
+                                  state_.gyro_bias[from].data(), state_.gyro_bias[to].data()),
+          from, to, 3);
     }
     // Priors on the columns of T_g - I; with pin_, the columns not excited are held instead.
     std::vector<int> free_entries, held_entries;

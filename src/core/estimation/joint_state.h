@@ -24,6 +24,10 @@ struct State {
   Eigen::Matrix3d R_cam_imu_0 = Eigen::Matrix3d::Identity();       ///< X0 (linearisation point)
   Eigen::Matrix3d R_world_target_0 = Eigen::Matrix3d::Identity();  ///< T0
   std::array<double, 3> e_X{}, e_T{};
+  /// With a mount change (JointProblem::mount_change_pose): R_cam_imu of the later poses,
+  /// Exp(e_X_after) X0_after.
+  Eigen::Matrix3d R_cam_imu_after_0 = Eigen::Matrix3d::Identity();
+  std::array<double, 3> e_X_after{};
   std::vector<std::array<double, 3>> delta;      ///< per pose (rad)
   std::array<double, 6> accel_matrix{};          ///< T_a - I
   std::array<double, 3> accel_bias{};            ///< m/s^2

@@ -143,6 +143,13 @@ std::string validateProblem(const JointProblem& problem, const Eigen::Matrix3d& 
   if (problem.poses.size() < 3) {
     return "needs at least 3 poses (got " + std::to_string(problem.poses.size()) + ")";
   }
+  if (problem.mount_change_pose != -1 &&
+      (problem.mount_change_pose < 1 ||
+       problem.mount_change_pose >= static_cast<int>(problem.poses.size()))) {
+    return "mount_change_pose " + std::to_string(problem.mount_change_pose) +
+           " is not a pose with poses before it (1.." + std::to_string(problem.poses.size() - 1) +
+           ", or -1)";
+  }
   if (!isRotationMatrix(R_cam_imu_initial, 1e-3)) {
     return "R_cam_imu_initial is not a rotation matrix";
   }
@@ -243,6 +250,9 @@ Eigen::Vector3d State::gyroBias(int pose) const {
 
 void State::foldRotationIncrements() {
   R_cam_imu_0 = projectToSO3(expSO3(Eigen::Vector3d(e_X[0], e_X[1], e_X[2])) * R_cam_imu_0);
+  R_cam_imu_after_0 = projectToSO3(
+      expSO3(Eigen::Vector3d(e_X_after[0], e_X_after[1], e_X_after[2])) * R_cam_imu_after_0);
+  e_X_after = {0.0, 0.0, 0.0};
   R_world_target_0 =
       projectToSO3(expSO3(Eigen::Vector3d(e_T[0], e_T[1], e_T[2])) * R_world_target_0);
   e_X = {0.0, 0.0, 0.0};

@@ -1,0 +1,69 @@
+// Change-point test for the camera-IMU mount: is the window better explained by two mounts, the
+// later poses from some pose s on with an R_cam_imu of their own, than by one?
+//
+// For each candidate s (the newest poses only: a change is looked for as the poses after it
+// arrive) the joint estimator solves the two-mount model (JointProblem::mount_change_pose = s:
+// a second R_cam_imu for poses s.., the IMU's parameters shared, the gyro motion into pose s
+// unused). The statistic is the drop of the chi-square,
+//   D(s) = chi2(one mount) - chi2(two mounts, split at s),
+// which without a change is chi-square distributed with dof(one) - dof(two) degrees of freedom
+// (3 for the second rotation + 3 for the gyro motion left out). It is judged as an F statistic,
+//   F = (D / dof_D) / max(1, chi2_two / dof_two),
+// so that a unit whose noise the priors understate (chi2/dof > 1) does not read as a remount; the
+// p-value is Bonferroni-corrected for the number of candidates. A change is declared when the
+// corrected p-value is below `level`; the split is the candidate with the largest D.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "camera_imu_alignment/estimation/joint_types.h"
+
+namespace camera_imu_alignment {
+
+struct MountChangeSettings {
+  /// False-alarm probability per test (one test per new pose): corrected p-value below it = change.
+  double level = 1e-4;
+  /// Poses needed after a split (2: one pose after a split is indistinguishable from a bad pose).
+  int min_poses_after = 2;
+  /// The newest this many poses are candidate first poses of a new mount (bounds the solves).
+  int max_poses_after = 4;
+  /// Poses needed before a split.
+  int min_poses_before = 2;
+  /// Returns "" when usable, else the first unusable setting, named by its key.
+  std::string validate() const;
+};
+
+/// One candidate split.
+struct MountChangeCandidate {
+  int first_pose_after = 0;  ///< index into JointProblem::poses
+  double statistic = 0;      ///< D = chi2(one) - chi2(two)
+  int dof = 0;               ///< dof_D
+  double p_value = 1;        ///< of F, not corrected
+  double change_deg = 0;     ///< angle between the two mounts' R_cam_imu
+  bool solved = false;       ///< the two-mount solve succeeded
+};
+
+struct MountChangeTest {
+  bool tested = false;    ///< enough poses and a usable one-mount estimate
+  bool detected = false;  ///< a change at `first_pose_after`
+  int first_pose_after = -1;
+  double p_value = 1;  ///< Bonferroni-corrected, of the best candidate
+  double change_deg = 0;
+  Eigen::Matrix3d R_cam_imu_before = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d R_cam_imu_after = Eigen::Matrix3d::Identity();
+  std::vector<MountChangeCandidate> candidates;
+  std::string message;  ///< one line: what was found
+};
+
+/// Tests `problem` (its mount_change_pose ignored) against `one_mount`, the joint estimate of
+/// the same problem with one mount (must be ok).
+MountChangeTest testMountChange(const JointProblem& problem, const JointResult& one_mount,
+                                const JointSettings& joint_settings,
+                                const MountChangeSettings& settings);
+
+/// P(F > f) for an F(d1, d2) distribution (1 when an argument is not usable).
+double fisherUpperTail(double f, int d1, int d2);
+
+}  // namespace camera_imu_alignment

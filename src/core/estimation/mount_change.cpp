@@ -1,0 +1,93 @@
+// Change-point test for the mount (mount_change.h).
+#include "camera_imu_alignment/estimation/mount_change.h"
+
+#include <algorithm>
+#include <boost/math/distributions/fisher_f.hpp>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "camera_imu_alignment/estimation/joint_estimator.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
+
+namespace camera_imu_alignment {
+
+std::string MountChangeSettings::validate() const {
+  std::ostringstream out;
+  if (!(level > 0.0 && level < 1.0)) {
+    out << "remount_level = " << level << ": must be within (0, 1)";
+  } else if (min_poses_after < 2) {
+    out << "remount_min_poses_after = " << min_poses_after << ": must be >= 2";
+  } else if (max_poses_after < min_poses_after) {
+    out << "remount_max_poses_after = " << max_poses_after
+        << ": must be >= remount_min_poses_after (" << min_poses_after << ")";
+  } else if (min_poses_before < 2) {
+    out << "remount_min_poses_before = " << min_poses_before << ": must be >= 2";
+  }
+  return out.str();
+}
+
+double fisherUpperTail(double f, int d1, int d2) {
+  if (d1 <= 0 || d2 <= 0 || !std::isfinite(f)) return 1.0;
+  if (f <= 0.0) return 1.0;
+  return boost::math::cdf(boost::math::complement(boost::math::fisher_f(d1, d2), f));
+}
+
+MountChangeTest testMountChange(const JointProblem& problem, const JointResult& one_mount,
+                                const JointSettings& joint_settings,
+                                const MountChangeSettings& settings) {
+  MountChangeTest test;
+  const int n = static_cast<int>(problem.poses.size());
+  const int first = std::max(settings.min_poses_before, n - settings.max_poses_after);
+  const int last = n - settings.min_poses_after;
+  if (!one_mount.ok || first > last) {
+    test.message = one_mount.ok
+                       ? "too few poses for the mount-change test (" + std::to_string(n) + ")"
+                       : "no one-mount estimate to test against";
+    return test;
+  }
+  test.tested = true;
+  const JointEstimator estimator(joint_settings);
+  int best = -1;
+  for (int s = first; s <= last; ++s) {
+    JointProblem split = problem;
+    split.mount_change_pose = s;
+    const JointResult two = estimator.solve(split, one_mount.R_cam_imu);
+    MountChangeCandidate c;
+    c.first_pose_after = s;
+    if (two.ok && two.R_cam_imu_after_change && two.dof > 0) {
+      c.solved = true;
+      c.statistic = std::max(0.0, one_mount.chi2 - two.chi2);
+      c.dof = one_mount.dof - two.dof;
+      const double scale = std::max(1.0, two.chi2 / two.dof);
+      c.p_value = fisherUpperTail(c.statistic / std::max(1, c.dof) / scale, c.dof, two.dof);
+      c.change_deg =
+          rad2deg(rotationAngle(two.R_cam_imu.transpose() * *two.R_cam_imu_after_change));
+      if (best < 0 || c.statistic > test.candidates[best].statistic) {
+        best = static_cast<int>(test.candidates.size());
+        test.R_cam_imu_before = two.R_cam_imu;
+        test.R_cam_imu_after = *two.R_cam_imu_after_change;
+      }
+    }
+    test.candidates.push_back(c);
+  }
+  if (best < 0) {
+    test.message = "the two-mount solves failed";
+    return test;
+  }
+  const MountChangeCandidate& chosen = test.candidates[best];
+  test.first_pose_after = chosen.first_pose_after;
+  test.p_value = std::min(1.0, chosen.p_value * static_cast<double>(test.candidates.size()));
+  test.change_deg = chosen.change_deg;
+  test.detected = test.p_value < settings.level;
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer),
+                "%s: split before pose %d of %d, mounts %.2f deg apart, chi2 drop %.1f (dof %d), "
+                "p %.2g (level %.2g)",
+                test.detected ? "mount changed" : "one mount", test.first_pose_after, n,
+                test.change_deg, chosen.statistic, chosen.dof, test.p_value, settings.level);
+  test.message = buffer;
+  return test;
+}
+
+}  // namespace camera_imu_alignment

@@ -1,0 +1,150 @@
+// The mount change-point test (estimation/mount_change.h) on joint problems generated from a known
+// truth (joint_problem_simulation.h): a mount turned between two poses is found at the right pose
+// with the right size once two poses follow it; an unchanged mount is not flagged, for an ideal,
+// a consumer and a noisy IMU; the F tail matches tabulated values.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "camera_imu_alignment/estimation/joint_estimator.h"
+#include "camera_imu_alignment/estimation/mount_change.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
+#include "joint_problem_simulation.h"
+
+namespace camera_imu_alignment {
+namespace {
+
+using test::JointSimulation;
+using test::JointSimulationOptions;
+using test::simulateJointProblem;
+
+enum class Grade { kIdeal, kConsumer, kNoisy };
+
+JointSimulationOptions optionsFor(Grade grade, int poses) {
+  JointSimulationOptions options;  // defaults: a consumer MEMS unit
+  options.num_poses = poses;
+  if (grade == Grade::kIdeal) {
+    options.gyro_scale = options.gyro_cross_axis = 0.0;
+    options.accel_scale = options.accel_cross_axis = options.accel_bias_m_s2 = 0.0;
+    options.hard_iron_t = options.soft_iron = 0.0;
+    options.gyro_bias_max_rad_s = 0.0;
+  } else if (grade == Grade::kNoisy) {
+    options.gyro_noise_density = 0.004;  // MEMS gyro on a vibrating mount
+    options.gyro_bias_max_rad_s = deg2rad(5.0);
+    options.accel_noise_m_s2 = 0.05;
+  }
+  return options;
+}
+
+/// The camera measurements of poses `first_after`.. as seen after the mount turned by `turn`
+/// (camera axes): R_cam_imu' = turn R_cam_imu, so R_target_cam' = R_target_cam turn^T.
+void remount(JointSimulation* sim, int first_after, const Eigen::Matrix3d& turn) {
+  for (std::size_t k = first_after; k < sim->problem.poses.size(); ++k) {
+    sim->problem.poses[k].R_target_cam = sim->problem.poses[k].R_target_cam * turn.transpose();
+  }
+}
+
+Eigen::Matrix3d turnAbout(const Eigen::Vector3d& axis, double angle_deg) {
+  return expSO3(axis.normalized() * deg2rad(angle_deg));
+}
+
+MountChangeTest runTest(const JointSimulation& sim) {
+  const JointSettings joint;
+  const JointResult one = JointEstimator(joint).solve(sim.problem, sim.R_cam_imu);
+  EXPECT_TRUE(one.ok) << one.message;
+  return testMountChange(sim.problem, one, joint, MountChangeSettings{});
+}
+
+TEST(MountChange, FisherTailMatchesTables) {
+  // Upper 5 % and 1 % points of F(3, 20): 3.10 and 4.94 (standard tables).
+  EXPECT_NEAR(fisherUpperTail(3.098, 3, 20), 0.05, 5e-4);
+  EXPECT_NEAR(fisherUpperTail(4.938, 3, 20), 0.01, 2e-4);
+  EXPECT_EQ(fisherUpperTail(0.0, 3, 20), 1.0);
+  EXPECT_EQ(fisherUpperTail(std::nan(""), 3, 20), 1.0);
+  EXPECT_EQ(fisherUpperTail(2.0, 0, 20), 1.0);
+}
+
+TEST(MountChange, FoundAtTheRightPoseWithTwoPosesAfter) {
+  // 2 deg (the smallest remount) about a different axis per seed, after pose 8 of 10.
+  const Eigen::Vector3d axes[] = {{1, 0, 0}, {0, 1, 1}, {1, -1, 0.5}};
+  for (Grade grade : {Grade::kIdeal, Grade::kConsumer, Grade::kNoisy}) {
+    for (int seed = 0; seed < 3; ++seed) {
+      JointSimulation sim = simulateJointProblem(optionsFor(grade, 10), 300 + seed);
+      remount(&sim, 8, turnAbout(axes[seed], 2.0));
+      const MountChangeTest test = runTest(sim);
+      ASSERT_TRUE(test.tested) << test.message;
+      EXPECT_TRUE(test.detected) << "grade " << static_cast<int>(grade) << " seed " << seed << ": "
+                                 << test.message;
+      EXPECT_EQ(test.first_pose_after, 8) << test.message;
+      EXPECT_NEAR(test.change_deg, 2.0, 0.3) << test.message;
+      // The later mount's estimate is the turned truth.
+      const Eigen::Matrix3d after_truth = turnAbout(axes[seed], 2.0) * sim.R_cam_imu;
+      EXPECT_LT(rad2deg(rotationAngle(test.R_cam_imu_after.transpose() * after_truth)), 0.3)
+          << test.message;
+    }
+  }
+}
+
+TEST(MountChange, NotFlaggedWithOnePoseAfter) {
+  // One pose after the turn cannot be told from one bad pose: no candidate split has fewer than
+  // min_poses_after (2) poses after it, so the change waits for the next pose.
+  JointSimulation sim = simulateJointProblem(optionsFor(Grade::kConsumer, 10), 310);
+  remount(&sim, 9, turnAbout({0, 0, 1}, 3.0));
+  const MountChangeTest test = runTest(sim);
+  EXPECT_FALSE(test.detected && test.first_pose_after == 9) << test.message;
+  for (const MountChangeCandidate& c : test.candidates) EXPECT_LE(c.first_pose_after, 8);
+}
+
+TEST(MountChange, NoFalseAlarmOnAnUnchangedMount) {
+  // 20 recordings per grade, 12 poses each: the test at the last pose (4 candidate splits) must
+  // not fire. At level 1e-4 the expected number of false alarms over all 60 is 0.006.
+  for (Grade grade : {Grade::kIdeal, Grade::kConsumer, Grade::kNoisy}) {
+    int alarms = 0;
+    double largest_statistic = 0.0;
+    for (int seed = 0; seed < 20; ++seed) {
+      const JointSimulation sim = simulateJointProblem(optionsFor(grade, 12), 400 + seed);
+      const MountChangeTest test = runTest(sim);
+      ASSERT_TRUE(test.tested) << test.message;
+      if (test.detected) ++alarms;
+      for (const MountChangeCandidate& c : test.candidates) {
+        largest_statistic = std::max(largest_statistic, c.statistic);
+      }
+    }
+    std::printf("grade %d: %d false alarms in 20, largest chi2 drop %.1f\n",
+                static_cast<int>(grade), alarms, largest_statistic);
+    EXPECT_EQ(alarms, 0) << "grade " << static_cast<int>(grade);
+  }
+}
+
+TEST(MountChange, SettingsValidated) {
+  MountChangeSettings s;
+  EXPECT_EQ(s.validate(), "");
+  s.min_poses_after = 1;
+  EXPECT_NE(s.validate().find("remount_min_poses_after"), std::string::npos);
+  s = MountChangeSettings{};
+  s.level = 0.0;
+  EXPECT_NE(s.validate().find("remount_level"), std::string::npos);
+  s = MountChangeSettings{};
+  s.max_poses_after = 1;
+  EXPECT_NE(s.validate().find("remount_max_poses_after"), std::string::npos);
+}
+
+TEST(MountChange, TwoMountModelRecoversBothRotations) {
+  // The estimator's two-mount model itself: the split given, both rotations recovered.
+  JointSimulation sim = simulateJointProblem(optionsFor(Grade::kConsumer, 10), 320);
+  const Eigen::Matrix3d turn = turnAbout({0.3, 1, 0}, 5.0);
+  remount(&sim, 5, turn);
+  sim.problem.mount_change_pose = 5;
+  const JointResult r = JointEstimator().solve(sim.problem, sim.R_cam_imu);
+  ASSERT_TRUE(r.ok) << r.message;
+  ASSERT_TRUE(r.R_cam_imu_after_change.has_value());
+  EXPECT_LT(rad2deg(rotationAngle(r.R_cam_imu.transpose() * sim.R_cam_imu)), 0.2);
+  EXPECT_LT(rad2deg(rotationAngle(r.R_cam_imu_after_change->transpose() * turn * sim.R_cam_imu)),
+            0.2);
+  sim.problem.mount_change_pose = 10;  // no pose after it: refused, not a crash
+  EXPECT_FALSE(JointEstimator().solve(sim.problem, sim.R_cam_imu).ok);
+}
+
+}  // namespace
+}  // namespace camera_imu_alignment
