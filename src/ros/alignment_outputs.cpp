@@ -15,7 +15,6 @@
 #include "camera_imu_alignment/io/default_frames.h"
 #include "camera_imu_alignment/io/input_error.h"
 #include "camera_imu_alignment/io/result_yaml.h"
-#include "camera_imu_alignment/ros/broadcast_gate.h"
 #include "camera_imu_alignment/ros/message_conversion.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 
@@ -53,42 +52,23 @@ std::string AlignmentWrapper::Impl::imuFrame() const {
   return frameOr(saved_imu_frame, kDefaultImuFrame);
 }
 
-void AlignmentWrapper::Impl::onResult(const AlignmentResult& result) {
-  last_result = result;
-  const GateOutcome gate =
-      judgeEstimate(result, pipeline->windowSize(), settings, published, recalibrating);
-  if (gate.decision == GateDecision::kReject) {
-    state = result.status == SolveStatus::kNotObservable ? "not_observable"
-            : recalibrating                              ? "recalibrating"
-                                                         : "collecting";
-    state_message = gate.why;
-    ROS_INFO_THROTTLE(2.0, "%s: estimate not broadcast: %s", name.c_str(), gate.why.c_str());
+void AlignmentWrapper::Impl::onBroadcast(const BroadcastEstimate& estimate) {
+  sendTransform(estimate.R_cam_imu);
+  if (estimate.source != "estimated" || settings.output_file.empty()) {
     publishStatus();
     return;
   }
-  state = "calibrated";
-  if (gate.decision == GateDecision::kKeep) {
-    state_message = "the broadcast estimate stays: " + gate.why;
-    publishStatus();
-    return;
-  }
-  accepted_result = result;
-  recalibrating = false;
-  state_message = result.message;
-  broadcast(result.R_cam_imu, result.quality.std_dev_deg.maxCoeff());
   std::string error;
-  if (!settings.output_file.empty()) {
-    if (save(result, &error)) {
-      save_error.clear();
-    } else {
-      save_error = error;
-      ROS_ERROR_THROTTLE(10.0, "%s: %s", name.c_str(), error.c_str());
-    }
+  if (save(estimate, &error)) {
+    save_error.clear();
+  } else {
+    save_error = error;
+    ROS_ERROR_THROTTLE(10.0, "%s: %s", name.c_str(), error.c_str());
   }
   publishStatus();
 }
 
-void AlignmentWrapper::Impl::broadcast(const Eigen::Matrix3d& R_cam_imu, double max_std_dev_deg) {
+void AlignmentWrapper::Impl::sendTransform(const Eigen::Matrix3d& R_cam_imu) {
   geometry_msgs::TransformStamped t;
   t.header.stamp = ros::Time::now();
   // A transform parent <- child maps child-frame points into the parent frame.
@@ -102,17 +82,19 @@ void AlignmentWrapper::Impl::broadcast(const Eigen::Matrix3d& R_cam_imu, double 
     t.transform.rotation = toQuaternionMsg(R_cam_imu);
   }
   broadcaster.sendTransform(t);
-  broadcast_R = R_cam_imu;
-  published = PublishedEstimate{R_cam_imu, max_std_dev_deg};
-  inconsistent_poses = 0;  // the remount check starts over against the new estimate
   ROS_INFO("%s: broadcasting %s -> %s, R_cam_imu %s", name.c_str(), t.header.frame_id.c_str(),
            t.child_frame_id.c_str(), rollPitchYawText(R_cam_imu, 3).c_str());
 }
 
-bool AlignmentWrapper::Impl::save(const AlignmentResult& result, std::string* error) {
+bool AlignmentWrapper::Impl::save(const BroadcastEstimate& estimate, std::string* error) {
+  if (!estimate.result) {
+    *error = "cannot save the calibration: the broadcast one was loaded, not estimated here";
+    return false;
+  }
   try {
-    ResultMetadata meta{cameraFrame(), imuFrame(), static_cast<int>(pipeline->windowSize())};
-    writeResultYaml(settings.output_file, result, meta);
+    // The broadcast estimate with its own quality: the poses behind it, not the window's now.
+    ResultMetadata meta{cameraFrame(), imuFrame(), estimate.poses};
+    writeResultYaml(settings.output_file, *estimate.result, meta);
     return true;
   } catch (const std::exception& e) {
     *error = std::string("cannot save the calibration: ") + e.what();
@@ -129,54 +111,81 @@ void AlignmentWrapper::Impl::loadSaved() {
   if (!stored) return;
   saved_camera_frame = stored->camera_frame;
   saved_imu_frame = stored->imu_frame;
-  broadcast(stored->R_cam_imu, std::numeric_limits<double>::infinity());
-  state = "calibrated";
-  state_message = "calibration loaded from " + settings.output_file;
-  ROS_INFO("%s: %s", name.c_str(), state_message.c_str());
+  BroadcastEstimate loaded;
+  loaded.R_cam_imu = stored->R_cam_imu;
+  if (stored->std_dev_deg) {
+    loaded.std_dev_deg = *stored->std_dev_deg;
+    // Its covariance as far as the file tells (per-axis 1-sigma; the correlations are not saved).
+    const Eigen::Vector3d sigma_rad = *stored->std_dev_deg * (M_PI / 180.0);
+    loaded.covariance_rad2 = Eigen::Matrix3d(sigma_rad.cwiseProduct(sigma_rad).asDiagonal());
+  }
+  loaded.poses = stored->num_poses;
+  loaded.source = "loaded: " + settings.output_file;
+  calibrator->loadBroadcast(loaded);
+  ROS_INFO("%s: calibration loaded from %s (%d poses, 1-sigma %s deg)", name.c_str(),
+           settings.output_file.c_str(), loaded.poses,
+           stored->std_dev_deg ? std::to_string(loaded.maxStdDevDeg()).c_str() : "unknown");
 }
 
 void AlignmentWrapper::Impl::publishStatus() {
   AlignmentStatus s;
-  s.header.stamp = clock.newest() > 0.0 ? ros::Time(clock.newest()) : ros::Time::now();
+  const double newest = calibrator->newestStamp();
+  s.header.stamp = newest > 0.0 ? ros::Time(newest) : ros::Time::now();
   s.header.frame_id = cameraFrame();
-  if (state == "waiting_for_data") {
-    if (pipeline->imuSamples() == 0) {
-      state_message = "waiting for IMU data on " + imu_sub.getTopic();
-    } else if (!pipeline->hasIntrinsics() && pipeline->frames() == 0) {
-      state_message = "waiting for the camera: nothing on " + topicOf(InputStream::kImage) + " / " +
-                      topicOf(InputStream::kCameraInfo) + " / " + camera_pose_sub.getTopic() +
-                      " yet";
+  const CalibrationPipeline& pipeline = calibrator->pipeline();
+  s.state = toString(calibrator->state());
+  s.message = calibrator->stateMessage();
+  if (calibrator->state() == CalibrationState::kWaitingForData) {
+    if (pipeline.imuSamples() == 0) {
+      s.message = "waiting for IMU data on " + imu_sub.getTopic();
     } else {
-      state = "collecting";
-      state_message = "waiting for stationary poses";
+      s.message = "waiting for the camera: nothing on " + topicOf(InputStream::kImage) + " / " +
+                  topicOf(InputStream::kCameraInfo) + " / " + camera_pose_sub.getTopic() + " yet";
     }
   }
-  s.state = state;
-  s.message = state_message;
-  s.poses_in_window = static_cast<std::uint32_t>(pipeline->windowSize());
-  s.poses_total = static_cast<std::uint32_t>(pipeline->posesTotal());
-  s.rests_total = static_cast<std::uint32_t>(pipeline->restsTotal());
-  const AlignmentResult* r = last_result ? &*last_result : nullptr;
+  s.poses_in_window = static_cast<std::uint32_t>(pipeline.windowSize());
+  s.poses_total = static_cast<std::uint32_t>(pipeline.posesTotal());
+  s.rests_total = static_cast<std::uint32_t>(pipeline.restsTotal());
+  s.remounts = static_cast<std::uint32_t>(calibrator->remounts());
   s.q_cam_imu.w = 1.0;
-  if (r) {
-    s.pairs = static_cast<std::uint32_t>(r->quality.num_pairs);
-    s.inliers = static_cast<std::uint32_t>(r->quality.num_inliers);
+  s.q_broadcast.w = 1.0;
+  const std::optional<BroadcastEstimate>& broadcast = calibrator->broadcast();
+  if (const std::optional<EstimateEvent>& e = calibrator->lastEstimate()) {
+    const AlignmentResult& r = e->result;
+    s.pairs = static_cast<std::uint32_t>(r.quality.num_pairs);
+    s.inliers = static_cast<std::uint32_t>(r.quality.num_inliers);
     s.has_estimate = true;
-    s.q_cam_imu = toQuaternionMsg(r->R_cam_imu);
-    s.residual_rms_deg = r->quality.residual_rms_deg;
-    for (int i = 0; i < 3; ++i) s.std_dev_deg[i] = r->quality.std_dev_deg(i);
-    s.observability = r->quality.observability;
-    s.rotate_about_cam.x = r->quality.excite_axis_cam.x();
-    s.rotate_about_cam.y = r->quality.excite_axis_cam.y();
-    s.rotate_about_cam.z = r->quality.excite_axis_cam.z();
+    s.q_cam_imu = toQuaternionMsg(r.R_cam_imu);
+    s.residual_rms_deg = r.quality.residual_rms_deg;
+    for (int i = 0; i < 3; ++i) s.std_dev_deg[i] = r.quality.std_dev_deg(i);
+    s.observability = r.quality.observability;
     s.broadcast =
-        broadcast_R && rad2deg(rotationAngle(broadcast_R->transpose() * r->R_cam_imu)) <= 1e-9;
+        broadcast && rad2deg(rotationAngle(broadcast->R_cam_imu.transpose() * r.R_cam_imu)) <= 1e-9;
+    if (r.joint && r.joint->ok) {
+      s.consistent = r.joint->chi2_p_value >= settings.online.consistency_level;
+      s.chi2 = r.joint->chi2;
+      s.dof = static_cast<std::uint32_t>(std::max(0, r.joint->dof));
+      s.p_value = r.joint->chi2_p_value;
+    }
   }
-  if (last_pose) {
-    s.last_pose_start = ros::Time(last_pose->start_s);
-    s.last_pose_end = ros::Time(last_pose->end_s);
-    s.last_pose_frames = static_cast<std::uint32_t>(last_pose->num_frames);
-    s.last_pose_imu_source = toString(last_pose->imu_source);
+  const Eigen::Vector3d axis = calibrator->rotateAboutCam();
+  s.rotate_about_cam.x = axis.x();
+  s.rotate_about_cam.y = axis.y();
+  s.rotate_about_cam.z = axis.z();
+  s.imu_guidance = calibrator->imuGuidance();
+  if (!s.imu_guidance.empty()) s.message += "; " + s.imu_guidance;
+  if (broadcast) {
+    s.has_broadcast = true;
+    s.q_broadcast = toQuaternionMsg(broadcast->R_cam_imu);
+    for (int i = 0; i < 3; ++i) s.broadcast_std_dev_deg[i] = broadcast->std_dev_deg(i);
+    s.broadcast_source = broadcast->source;
+    s.broadcast_poses = static_cast<std::uint32_t>(broadcast->poses);
+  }
+  if (const std::optional<StationaryPose>& last = calibrator->lastPose()) {
+    s.last_pose_start = ros::Time(last->start_s);
+    s.last_pose_end = ros::Time(last->end_s);
+    s.last_pose_frames = static_cast<std::uint32_t>(last->num_frames);
+    s.last_pose_imu_source = toString(last->imu_source);
   }
   status_pub.publish(s);
 }
@@ -184,11 +193,12 @@ void AlignmentWrapper::Impl::publishStatus() {
 void AlignmentWrapper::Impl::publishPoses() {
   // Camera orientations at the poses, in the target frame (rviz: fixed frame = the target).
   geometry_msgs::PoseArray out;
-  out.header.stamp = ros::Time(std::max(clock.newest(), 0.0));
+  out.header.stamp = ros::Time(std::max(calibrator->newestStamp(), 0.0));
+  const CalibrationPipeline& pipeline = calibrator->pipeline();
   out.header.frame_id = "calibration_target";
   // The poses in the sliding window: the newest windowSize() of the history.
-  const std::vector<StationaryPose>& history = pipeline->poses();
-  const std::size_t first = history.size() - std::min(history.size(), pipeline->windowSize());
+  const std::vector<StationaryPose>& history = pipeline.poses();
+  const std::size_t first = history.size() - std::min(history.size(), pipeline.windowSize());
   for (std::size_t i = first; i < history.size(); ++i) {
     const StationaryPose& p = history[i];
     geometry_msgs::Pose pose;
@@ -199,9 +209,9 @@ void AlignmentWrapper::Impl::publishPoses() {
     out.poses.push_back(pose);
   }
   poses_pub.publish(out);
-  if (pipeline->poses().empty()) return;
+  if (pipeline.poses().empty()) return;
   // The target seen from the camera at the last pose: R_cam_target = R_target_cam^T.
-  const StationaryPose& last = pipeline->poses().back();
+  const StationaryPose& last = pipeline.poses().back();
   geometry_msgs::PoseStamped target;
   target.header.stamp = ros::Time(last.end_s);
   target.header.frame_id = cameraFrame();
@@ -251,11 +261,14 @@ void AlignmentWrapper::Impl::publishDebugImage(const cv::Mat& mono8,
   debug_pub.publish(out);
 }
 
-bool AlignmentWrapper::Impl::onCalibrate(Calibrate::Request&, Calibrate::Response& res) {
-  const AlignmentResult r = pipeline->solve();
-  res.poses = static_cast<std::uint32_t>(pipeline->windowSize());
+bool AlignmentWrapper::Impl::onCalibrate(Calibrate::Request& req, Calibrate::Response& res) {
+  const CalibrateOutcome outcome = calibrator->calibrateNow(req.force);
+  const AlignmentResult& r = outcome.result;
+  res.poses = static_cast<std::uint32_t>(outcome.window_poses);
   res.observable = r.quality.observable && r.status != SolveStatus::kBadInput;
   res.success = r.status == SolveStatus::kOk;
+  res.broadcast = outcome.broadcast;
+  res.not_broadcast_reason = outcome.not_broadcast_reason;
   res.message = r.message;
   if (r.status != SolveStatus::kBadInput) {
     res.q_cam_imu = toQuaternionMsg(r.R_cam_imu);
@@ -265,42 +278,39 @@ bool AlignmentWrapper::Impl::onCalibrate(Calibrate::Request&, Calibrate::Respons
       res.std_dev_deg[i] = r.quality.std_dev_deg(i);
     }
     res.residual_rms_deg = r.quality.residual_rms_deg;
-    onResult(r);  // gates, broadcast, save, status
   } else {
     res.q_cam_imu.w = 1.0;
   }
+  publishStatus();
   return true;
 }
 
 bool AlignmentWrapper::Impl::onReset(std_srvs::Trigger::Request&,
                                      std_srvs::Trigger::Response& res) {
-  pipeline->reset();
-  last_result.reset();
-  published.reset();  // starting over: the next good estimate replaces the tf, however precise
-  last_pose.reset();
-  inconsistent_poses = 0;
-  recalibrating = false;
-  state = broadcast_R ? "collecting" : "waiting_for_data";
-  state_message =
-      "reset: window and buffers cleared" +
-      std::string(broadcast_R ? "; the broadcast calibration stays until a new one" : "");
+  calibrator->reset();
   res.success = true;
-  res.message = state_message;
+  res.message = calibrator->stateMessage();
+  publishPoses();
   publishStatus();
   return true;
 }
 
 bool AlignmentWrapper::Impl::onSave(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  const std::optional<BroadcastEstimate>& broadcast = calibrator->broadcast();
   if (settings.output_file.empty()) {
     res.success = false;
     res.message = "no output_file parameter set";
-  } else if (!accepted_result) {
+  } else if (!broadcast || !broadcast->result) {
     res.success = false;
-    res.message = "no calibration has passed the quality gates yet";
+    res.message = broadcast ? "the broadcast calibration was loaded from a file, not estimated in "
+                              "this run: nothing new to save"
+                            : "no calibration has passed the quality gates yet";
   } else {
     std::string error;
-    res.success = save(*accepted_result, &error);
-    res.message = res.success ? "saved to " + settings.output_file : error;
+    res.success = save(*broadcast, &error);
+    res.message = res.success ? "saved to " + settings.output_file + " (" +
+                                    std::to_string(broadcast->poses) + " poses)"
+                              : error;
     save_error = error;
   }
   return true;
@@ -308,12 +318,12 @@ bool AlignmentWrapper::Impl::onSave(std_srvs::Trigger::Request&, std_srvs::Trigg
 
 bool AlignmentWrapper::Impl::onCapturePose(std_srvs::Trigger::Request&,
                                            std_srvs::Trigger::Response& res) {
-  if (!settings.manual_capture) {
+  if (!settings.online.manual_capture) {
     res.success = false;
     res.message = "manual_capture is false: every rest becomes a pose automatically";
     return true;
   }
-  capture_armed = true;
+  calibrator->armCapture();
   res.success = true;
   res.message = "armed: the current (or next) rest becomes a pose when the rig moves again";
   return true;
@@ -321,15 +331,27 @@ bool AlignmentWrapper::Impl::onCapturePose(std_srvs::Trigger::Request&,
 
 void AlignmentWrapper::Impl::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   using diagnostic_msgs::DiagnosticStatus;
-  const unsigned char level = state == "calibrated"       ? DiagnosticStatus::OK
-                              : state == "not_observable" ? DiagnosticStatus::WARN
-                              : state == "recalibrating"  ? DiagnosticStatus::WARN
-                                                          : DiagnosticStatus::OK;
-  if (save_error.empty()) {
-    status.summary(level, state + ": " + state_message);
-  } else {
-    status.summary(DiagnosticStatus::WARN, state + ": " + state_message + "; " + save_error);
+  const CalibrationPipeline& pipeline = calibrator->pipeline();
+  const CalibrationState state = calibrator->state();
+  std::vector<std::string> problems;  // each makes the summary WARN
+  if (state == CalibrationState::kNotObservable || state == CalibrationState::kRecalibrating) {
+    problems.push_back(calibrator->stateMessage());
   }
+  for (InputStream stream : silentStreams()) {
+    problems.push_back("nothing on " + topicOf(stream) + " while other inputs flow");
+  }
+  const std::uint64_t not_found = pipeline.rejections().count(RejectReason::kTargetNotFound);
+  if (pipeline.framesDetected() >= 20 && not_found >= pipeline.framesDetected()) {
+    problems.push_back("the target was not found in any of " +
+                       std::to_string(pipeline.framesDetected()) +
+                       " frames at rest: does target_file describe the board in view?");
+  }
+  if (!save_error.empty()) problems.push_back(save_error);
+  std::string summary = std::string(toString(state)) + ": " + calibrator->stateMessage();
+  for (const std::string& p : problems) {
+    if (summary.find(p) == std::string::npos) summary += "; " + p;
+  }
+  status.summary(problems.empty() ? DiagnosticStatus::OK : DiagnosticStatus::WARN, summary);
   status.add("last save error", save_error.empty() ? "none" : save_error);
   const double elapsed = std::max(1e-3, (ros::WallTime::now() - last_diagnostics).toSec());
   last_diagnostics = ros::WallTime::now();
@@ -337,14 +359,15 @@ void AlignmentWrapper::Impl::diagnose(diagnostic_updater::DiagnosticStatusWrappe
   status.add("magnetometer rate (Hz)", mag_count / elapsed);
   status.add("image rate (Hz)", image_count / elapsed);
   imu_count = mag_count = image_count = 0;
-  status.add("imu samples", pipeline->imuSamples());
-  status.add("magnetometer samples", pipeline->magneticSamples());
-  status.add("frames", pipeline->frames());
-  status.add("frames detected", pipeline->framesDetected());
-  status.add("poses in window", pipeline->windowSize());
-  status.add("imu gaps", pipeline->imuGaps());
+  status.add("imu samples", pipeline.imuSamples());
+  status.add("magnetometer samples", pipeline.magneticSamples());
+  status.add("frames", pipeline.frames());
+  status.add("frames detected", pipeline.framesDetected());
+  status.add("poses in window", pipeline.windowSize());
+  status.add("remounts", calibrator->remounts());
+  status.add("imu gaps", pipeline.imuGaps());
   // One key per reason, zeros included, so that monitors can track each.
-  const RejectionCounts& rejections = pipeline->rejections();
+  const RejectionCounts& rejections = pipeline.rejections();
   status.add("rejected inputs", rejections.summary());
   for (int i = 0; i < static_cast<int>(RejectReason::kCount); ++i) {
     const auto reason = static_cast<RejectReason>(i);

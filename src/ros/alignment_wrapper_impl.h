@@ -1,5 +1,6 @@
-// Private state of AlignmentWrapper, shared by its two source files (inputs and pipeline:
-// alignment_wrapper.cpp; gates, tf, status, files, services: alignment_outputs.cpp). Not installed.
+// Private state of AlignmentWrapper, shared by its two source files (inputs: alignment_wrapper.cpp;
+// tf, status, files, services, diagnostics: alignment_outputs.cpp). The policy (gates, remount,
+// state) is the OnlineCalibrator's; this is the ROS side only. Not installed.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -22,11 +23,10 @@
 #include <optional>
 
 #include "camera_imu_alignment/Calibrate.h"
-#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/pipeline/online_calibrator.h"
 #include "camera_imu_alignment/ros/alignment_wrapper.h"
-#include "camera_imu_alignment/ros/broadcast_gate.h"
-#include "camera_imu_alignment/ros/clock_jump.h"
 #include "camera_imu_alignment/ros/message_input.h"
+#include "camera_imu_alignment/ros/stream_watch.h"
 #include "camera_imu_alignment/ros/wrapper_settings.h"
 #include "camera_imu_alignment/vision/target_detector.h"
 
@@ -41,7 +41,7 @@ struct AlignmentWrapper::Impl {
   std::string name;
   WrapperSettings settings;
   PipelineSettings pipeline_settings;
-  std::unique_ptr<CalibrationPipeline> pipeline;
+  std::unique_ptr<OnlineCalibrator> calibrator;
 
   // --- inputs
   // The magnetometer's frame differs from the IMU's: R_imu_mag from tf, looked up by MessageInput
@@ -55,18 +55,23 @@ struct AlignmentWrapper::Impl {
   // subscriptions to <image topic>/compressed and the sibling camera_info, whose latest message
   // goes with each image.
   ros::Subscriber compressed_sub, info_sub;
+  /// raw transport: camera info on its own as well, to tell a silent image topic from a silent
+  /// camera info topic (image_transport only calls back with both).
+  ros::Subscriber info_watch_sub;
   sensor_msgs::CameraInfoConstPtr latest_info;
   std::unique_ptr<MessageInput> input;  ///< the checks and conversions calibrate_bag uses too
-  ClockJumpDetector clock;              ///< bag loops, restarted clocks
-  bool reset_requested = false;         ///< applied after the pipeline call returns
-  bool capture_armed = false;           ///< manual_capture: ~capture_pose called for this rest
   ros::WallTime last_imu_wall;          ///< receipt time of the newest IMU message
   bool input_stopped = true;            ///< no IMU for a while: the rest in progress was closed
-  ros::WallTimer stale_timer;
-  std::uint64_t imu_gaps_warned = 0;  ///< pipeline->imuGaps() when last warned about
+  ros::WallTimer stale_timer, poll_timer;
+  std::uint64_t imu_gaps_warned = 0;  ///< imuGaps() when last warned about
+  StreamWatch streams;                ///< silent topics while others flow
+  std::map<InputStream, ros::WallTime> last_silent_warning;
+  bool mag_absence_noted = false;
   /// IMU silent for 2 s of wall time (a bag ended, a driver stopped): close the rest in progress
-  /// so that the last pose counts.
+  /// so that the last pose counts. Also warns about silent topics.
   void checkStale();
+  void warnSilentStreams();
+  std::vector<InputStream> silentStreams() const;
   void onImu(const sensor_msgs::ImuConstPtr& msg);
   void onMag(const sensor_msgs::MagneticFieldConstPtr& msg);
   void onImage(const sensor_msgs::ImageConstPtr& image,
@@ -81,23 +86,20 @@ struct AlignmentWrapper::Impl {
   /// camera_pose (geometry_msgs/PoseStamped, the camera in the target frame): orientations from
   /// the user's own detector or motion capture instead of images.
   void onCameraPose(const geometry_msgs::PoseStampedConstPtr& msg);
-  /// Stamp check shared by the inputs: a zero stamp is dropped (counted); a jump back by more
-  /// than a second on one input (a bag loop) resets the buffers with a warning. False when the
-  /// message is to be dropped.
-  bool acceptStamp(const std_msgs::Header& header, InputStream stream);
-  void applyPendingReset();
   /// The topic an input stream arrives on (resolved name), for messages.
   std::string topicOf(InputStream stream) const;
 
-  // --- pipeline callbacks
+  // --- the calibrator's events
   void onPose(const StationaryPose& pose);
   void onPoseRejected(const RejectedPose& rejected);
-  void onResult(const AlignmentResult& result);
+  void onEstimate(const EstimateEvent& event);
+  void onBroadcast(const BroadcastEstimate& estimate);
+  void onRemount(const RemountEvent& event);
+  void onClockJump(double jump_s, InputStream stream);
   void onReject(RejectReason reason, InputStream stream, const std::string& detail);
   /// Warnings are throttled per input and reason: a flood of one kind hides no other.
   std::map<std::pair<InputStream, RejectReason>, ros::WallTime> last_reject_warning;
   std::map<std::pair<InputStream, RejectReason>, std::uint64_t> unwarned_rejects;
-  int inconsistent_poses = 0;  ///< consecutive poses that disagree with the broadcast estimate
 
   // --- outputs (alignment_outputs.cpp)
   tf2_ros::StaticTransformBroadcaster broadcaster;
@@ -115,20 +117,14 @@ struct AlignmentWrapper::Impl {
   ros::ServiceServer calibrate_srv, reset_srv, save_srv, capture_srv;
   ros::WallTimer status_timer;
   diagnostic_updater::Updater diagnostics;
-  std::optional<AlignmentResult> last_result;      ///< latest solve
-  std::optional<Eigen::Matrix3d> broadcast_R;      ///< what the static tf says now
-  std::optional<AlignmentResult> accepted_result;  ///< latest result that passed the gates
-  std::string state = "waiting_for_data";
-  std::string state_message = "waiting for IMU and camera data";
-  bool recalibrating = false;
-  std::optional<StationaryPose> last_pose;
   std::string saved_camera_frame,
       saved_imu_frame;  ///< from the loaded file, until inputs name them
 
   void advertise();
-  std::optional<PublishedEstimate> published;  ///< judgeEstimate's reference
-  void broadcast(const Eigen::Matrix3d& R_cam_imu, double max_std_dev_deg);
-  bool save(const AlignmentResult& result, std::string* error);
+  /// The static tf for R_cam_imu.
+  void sendTransform(const Eigen::Matrix3d& R_cam_imu);
+  /// Writes the broadcast estimate with its own quality (poses behind it, 1-sigma) to output_file.
+  bool save(const BroadcastEstimate& estimate, std::string* error);
   std::string save_error;  ///< why the last save failed ("" after a good one): diagnostics
   void loadSaved();
   void publishStatus();

@@ -16,8 +16,7 @@ std::string normalizeFrameId(const std::string& frame_id) {
   return frame_id.substr(start);
 }
 
-MessageInput::MessageInput(CalibrationPipeline* pipeline,
-                           std::function<void(const std::string&)> notice)
+MessageInput::MessageInput(SampleSink* pipeline, std::function<void(const std::string&)> notice)
     : pipeline_(pipeline), notice_(std::move(notice)) {}
 
 bool MessageInput::checkStamp(const std_msgs::Header& header, InputStream stream) {
@@ -107,7 +106,7 @@ std::string MessageInput::topicOf(InputStream stream) const {
 }
 
 void MessageInput::checkMessageOrientation(const ImuSample& sample) {
-  if (pipeline_->settings().imu_orientation != ImuOrientationSource::kMessage) return;
+  if (pipeline_->imuOrientationSource() != ImuOrientationSource::kMessage) return;
   if (sample.q_world_imu) {
     noted_missing_orientation_ = false;
     return;

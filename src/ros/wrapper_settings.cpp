@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "camera_imu_alignment/io/input_error.h"
+#include "camera_imu_alignment/pipeline/online_config.h"
 #include "camera_imu_alignment/pipeline/pipeline_config.h"
 
 namespace camera_imu_alignment {
@@ -37,13 +38,6 @@ const std::vector<Key>& keys() {
       field("publish_inverse", &WrapperSettings::publish_inverse, kBool),
       field("output_file", &WrapperSettings::output_file, "a file path (text), or empty"),
       field("load_on_start", &WrapperSettings::load_on_start, kBool),
-      field("min_poses", &WrapperSettings::min_poses, "an integer >= 2"),
-      field("max_residual_deg", &WrapperSettings::max_residual_deg, kPositive),
-      field("max_std_dev_deg", &WrapperSettings::max_std_dev_deg, kPositive),
-      field("min_change_deg", &WrapperSettings::min_change_deg, "a finite number >= 0"),
-      field("manual_capture", &WrapperSettings::manual_capture, kBool),
-      field("remount_poses", &WrapperSettings::remount_poses, "an integer >= 1"),
-      field("remount_residual_deg", &WrapperSettings::remount_residual_deg, kPositive),
       field("status_period_s", &WrapperSettings::status_period_s, kPositive),
       {"image_transport",
        [](const YAML::Node& node, WrapperSettings* s) {
@@ -91,16 +85,6 @@ YAML::Node toYaml(XmlRpc::XmlRpcValue& value, const std::string& name) {
 std::string check(const WrapperSettings& s) {
   auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
   if (s.target_file.empty()) return "target_file is required (a Kalibr target YAML)";
-  if (s.min_poses < 2) return bad("min_poses", s.min_poses);
-  if (!positive(s.max_residual_deg)) return bad("max_residual_deg", s.max_residual_deg);
-  if (!positive(s.max_std_dev_deg)) return bad("max_std_dev_deg", s.max_std_dev_deg);
-  if (!(std::isfinite(s.min_change_deg) && s.min_change_deg >= 0.0)) {
-    return bad("min_change_deg", s.min_change_deg);
-  }
-  if (s.remount_poses < 1) return bad("remount_poses", s.remount_poses);
-  if (!positive(s.remount_residual_deg)) {
-    return bad("remount_residual_deg", s.remount_residual_deg);
-  }
   if (!positive(s.status_period_s)) return bad("status_period_s", s.status_period_s);
   return "";
 }
@@ -148,26 +132,22 @@ const std::vector<std::string>& wrapperKeys() {
 
 void parseSettings(const YAML::Node& root, const std::string& source, WrapperSettings* wrapper,
                    PipelineSettings* pipeline) {
-  // One pass over the map and the two tables: a key is the wrapper's or else the pipeline's
-  // (whose reader names an unknown key).
+  // One pass over the map and the three tables: a key is the wrapper's, else the calibrator's,
+  // else the pipeline's (whose reader names an unknown key).
   WrapperSettings updated = *wrapper;
   PipelineSettings updated_pipeline = *pipeline;
-  if (root.IsMap()) {
-    for (const auto& entry : root) {
-      const std::string name = entry.first.as<std::string>();
-      const Key* key = findKey(keys(), name);
-      if (!key) {
-        readPipelineKey(source, name, entry.second, &updated_pipeline);
-        continue;
-      }
-      try {
-        key->read(entry.second, &updated);
-      } catch (const YAML::Exception&) {
-        throw InputError(badValueMessage(source, name, yamlText(entry.second), key->allowed));
-      }
-    }
-  }
-  checkPipelineSettings(source, updated_pipeline);
+  parseCalibrationConfig(
+      root, source, &updated_pipeline, &updated.online,
+      [&](const std::string& name, const YAML::Node& value) {
+        const Key* key = findKey(keys(), name);
+        if (!key) return false;
+        try {
+          key->read(value, &updated);
+        } catch (const YAML::Exception&) {
+          throw InputError(badValueMessage(source, name, yamlText(value), key->allowed));
+        }
+        return true;
+      });
   const std::string error = check(updated);
   if (!error.empty()) throw InputError(source + ": " + error);
   *wrapper = updated;

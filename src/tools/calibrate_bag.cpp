@@ -16,6 +16,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -28,6 +29,8 @@
 #include "camera_imu_alignment/io/joint_yaml.h"
 #include "camera_imu_alignment/io/result_yaml.h"
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/pipeline/online_calibrator.h"
+#include "camera_imu_alignment/pipeline/online_config.h"
 #include "camera_imu_alignment/pipeline/pipeline_config.h"
 #include "camera_imu_alignment/ros/message_input.h"
 #include "camera_imu_alignment/ros/wrapper_settings.h"
@@ -42,6 +45,7 @@ namespace {
 using cia::kExitBadInput;
 using cia::kExitNotEnoughInformation;
 using cia::kExitOk;
+using cia::kExitQualityGate;
 
 const char* kUsage =
     "usage: calibrate_bag --bag FILE.bag --target TARGET.yaml [--config PARAMS.yaml]\n"
@@ -107,7 +111,8 @@ class Progress {
  public:
   Progress(bool enabled, double start_s, double end_s)
       : enabled_(enabled), tty_(isatty(fileno(stderr))), start_(start_s), end_(end_s) {}
-  void update(double t, const cia::CalibrationPipeline& pipeline, bool force = false) {
+  void update(double t, const cia::OnlineCalibrator& calibrator, bool force = false) {
+    const cia::CalibrationPipeline& pipeline = calibrator.pipeline();
     if (!enabled_) return;
     const double span = end_ - start_;
     const int percent = span > 0.0 ? static_cast<int>(100.0 * (t - start_) / span) : 100;
@@ -117,9 +122,10 @@ class Progress {
     std::ostringstream line;
     line << "[calibrate_bag] " << std::setw(3) << std::min(percent, 100) << "% of bag time, "
          << pipeline.segments().size() << " rests, " << pipeline.poses().size() << " poses";
-    if (const auto result = pipeline.lastResult()) {
-      line << ", R_cam_imu " << cia::rollPitchYawText(result->R_cam_imu, 2) << " +- " << std::fixed
-           << std::setprecision(2) << result->quality.std_dev_deg.maxCoeff();
+    if (const auto& estimate = calibrator.lastEstimate()) {
+      const cia::AlignmentResult& result = estimate->result;
+      line << ", R_cam_imu " << cia::rollPitchYawText(result.R_cam_imu, 2) << " +- " << std::fixed
+           << std::setprecision(2) << result.quality.std_dev_deg.maxCoeff();
     }
     if (tty_) {
       std::cerr << "\r\033[K" << line.str() << std::flush;
@@ -198,14 +204,14 @@ void readStaticTransforms(const rosbag::Bag& bag, tf2::BufferCore* tf) {
 /// Feeds every message of the selected topics to the pipeline. Throws rosbag exceptions on a
 /// corrupt or truncated bag.
 void readBag(const rosbag::Bag& bag, const cia::BagTopics& topics,
-             cia::CalibrationPipeline* pipeline, Progress* progress, RunInfo* info) {
+             cia::OnlineCalibrator* calibrator, Progress* progress, RunInfo* info) {
   std::vector<std::string> names = {topics.imu};
   for (const auto& t : {topics.mag, topics.image, topics.camera_info}) {
     if (!t.empty()) names.push_back(t);
   }
   rosbag::View view(bag, rosbag::TopicQuery(names));
   // The nodelet's checks and conversions (MessageInput), so that both refuse the same messages.
-  cia::MessageInput input(pipeline, [](const std::string& notice) {
+  cia::MessageInput input(calibrator, [](const std::string& notice) {
     std::cerr << "[calibrate_bag] note: " << notice << "\n";
   });
   tf2::BufferCore static_tf;
@@ -228,12 +234,12 @@ void readBag(const rosbag::Bag& bag, const cia::BagTopics& topics,
         input.addImage(*msg);
       }
     }
-    progress->update(m.getTime().toSec(), *pipeline);
+    progress->update(m.getTime().toSec(), *calibrator);
   }
   info->imu_frame = input.imuFrame();
   info->camera_frame = input.cameraFrame();
-  pipeline->finish();
-  progress->update(info->end_s, *pipeline, true);
+  calibrator->finish();
+  progress->update(info->end_s, *calibrator, true);
   progress->done();
 }
 
@@ -259,10 +265,12 @@ int run(const cia::CliArgs& args) {
   // --- Inputs: target, settings, bag, topics. Each failure names its file, option or topic.
   cia::TargetDescription target;
   cia::PipelineSettings settings;
+  cia::OnlineSettings online;  // the nodelet's quality gates and change detection
   try {
     target = cia::loadTargetYaml(args.get("--target"));
-    if (args.has("--config"))
-      cia::loadPipelineConfig(args.get("--config"), &settings, cia::wrapperKeys());
+    if (args.has("--config")) {
+      cia::loadCalibrationConfig(args.get("--config"), &settings, &online, cia::wrapperKeys());
+    }
   } catch (const cia::InputError& e) {
     std::cerr << "calibrate_bag: " << e.what() << "\n";
     return kExitBadInput;
@@ -311,15 +319,26 @@ int run(const cia::CliArgs& args) {
             << target.describe() << "\n";
 
   // --- Run the pipeline over the bag.
+  // The nodelet's calibrator (poses, solves, change detection, gates), solving as poses arrive.
   RejectLog reject_log(topics);
-  cia::PipelineCallbacks callbacks;
+  std::vector<cia::RemountEvent> remounts;
+  cia::OnlineCallbacks callbacks;
   callbacks.on_reject = [&](cia::RejectReason r, cia::InputStream stream, const std::string& d) {
     reject_log(r, stream, d);
   };
-  cia::CalibrationPipeline pipeline(target, settings, callbacks);
+  callbacks.on_remount = [&](const cia::RemountEvent& e) { remounts.push_back(e); };
+  online.threaded = false;
+  std::unique_ptr<cia::OnlineCalibrator> calibrator;
+  try {
+    calibrator = std::make_unique<cia::OnlineCalibrator>(target, settings, online, callbacks);
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "calibrate_bag: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  const cia::CalibrationPipeline& pipeline = calibrator->pipeline();
   Progress progress(!args.has("--quiet"), info.start_s, info.end_s);
   try {
-    readBag(bag, topics, &pipeline, &progress, &info);
+    readBag(bag, topics, calibrator.get(), &progress, &info);
   } catch (const std::exception& e) {
     progress.done();
     std::cerr << "calibrate_bag: " << bag_path << ": cannot read the bag to the end (" << e.what()
@@ -345,7 +364,8 @@ int run(const cia::CliArgs& args) {
     return kExitBadInput;
   }
   cia::ReportInput report;
-  report.result = pipeline.solve();
+  const cia::CalibrateOutcome outcome = calibrator->calibrateNow(false);
+  report.result = outcome.result;
   report.poses = pipeline.poses();
   report.rejected = pipeline.rejectedPoses();
   report.segments = pipeline.segments();
@@ -361,6 +381,25 @@ int run(const cia::CliArgs& args) {
     std::cout << std::fixed << std::setprecision(4) << "error to " << args.get("--truth") << ": "
               << cia::rad2deg(cia::geodesicDistance(report.result.R_cam_imu, truth->R_cam_imu))
               << " deg\n";
+  }
+  // The nodelet's verdict: a remount during the recording, a failed quality gate.
+  for (const cia::RemountEvent& e : remounts) {
+    std::cout << "remount: " << e.message << "\n";
+  }
+  const bool gates_passed = outcome.gate.decision != cia::GateDecision::kReject && remounts.empty();
+  if (report.result.status == cia::SolveStatus::kOk) {
+    std::cout << "verdict: "
+              << (gates_passed ? std::string("PASSED (the nodelet would broadcast it)")
+                  : remounts.empty()
+                      ? "FAILED: " + outcome.gate.why
+                      : "FAILED: the mount changed during the recording (first at pose " +
+                            std::to_string(remounts.front().first_pose_index) +
+                            "); the estimate is of the last mount, from the poses after the "
+                            "change" +
+                            (outcome.gate.decision != cia::GateDecision::kReject
+                                 ? std::string()
+                                 : "; and " + outcome.gate.why))
+              << "\n";
   }
   if (args.has("--report")) {
     std::string error;
@@ -382,10 +421,15 @@ int run(const cia::CliArgs& args) {
     std::cerr << "calibrate_bag: " << report.result.message << "\n";
     return kExitNotEnoughInformation;  // the bag was read; it did not hold enough information
   }
+  if (!gates_passed) {
+    std::cerr << "calibrate_bag: the estimate fails the quality gates (see 'verdict:'); not "
+                 "written to --output / --imu-yaml\n";
+    return kExitQualityGate;
+  }
   if (args.has("--output")) {
     try {
       cia::ResultMetadata meta{report.camera_frame, report.imu_frame,
-                               static_cast<int>(pipeline.poses().size())};
+                               static_cast<int>(outcome.window_poses)};
       cia::writeResultYaml(args.get("--output"), report.result, meta);
     } catch (const cia::InputError& e) {
       std::cerr << "calibrate_bag: " << e.what() << "\n";

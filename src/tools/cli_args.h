@@ -13,6 +13,9 @@ namespace camera_imu_alignment {
 constexpr int kExitOk = 0;
 constexpr int kExitBadInput = 2;              ///< bad input or usage; the message names the culprit
 constexpr int kExitNotEnoughInformation = 3;  ///< not observable, or the two-step did not fit
+/// The estimate exists but fails the nodelet's quality gates (inconsistent data, 1-sigma too
+/// large) or the mount changed during the recording: calibrate_bag prints it, does not write it.
+constexpr int kExitQualityGate = 4;
 
 class UsageError : public std::runtime_error {
  public:

@@ -10,8 +10,11 @@
 // (3 for the second rotation + 3 for the gyro motion left out). It is judged as an F statistic,
 //   F = (D / dof_D) / max(1, chi2_two / dof_two),
 // so that a unit whose noise the priors understate (chi2/dof > 1) does not read as a remount; the
-// p-value is Bonferroni-corrected for the number of candidates. A change is declared when the
-// corrected p-value is below `level`; the split is the candidate with the largest D.
+// p-value is Bonferroni-corrected for the number of candidates. A candidate counts only when the
+// two-mount model fits every pose: no pose's RMS whitened residual (JointResult::
+// pose_residual_norm) above max(2, 3 x the median pose's). A split next to the true one, or one
+// pose that is merely bad, leaves a pose unfitted however large D is. A change is declared when
+// the corrected p-value of the counting candidate with the largest D is below `level`.
 #pragma once
 
 #include <Eigen/Core>
@@ -43,6 +46,9 @@ struct MountChangeCandidate {
   double p_value = 1;        ///< of F, not corrected
   double change_deg = 0;     ///< angle between the two mounts' R_cam_imu
   bool solved = false;       ///< the two-mount solve succeeded
+  /// Worst pose residual over max(2, 3 x median) in the two-mount solve; <= 1: fits every pose.
+  double worst_pose_misfit = 0;
+  bool fits_every_pose = false;
 };
 
 struct MountChangeTest {

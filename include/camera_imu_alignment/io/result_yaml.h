@@ -31,6 +31,10 @@ struct StoredCalibration {
   std::string camera_frame;
   std::string imu_frame;
   Eigen::Matrix3d R_cam_imu = Eigen::Matrix3d::Identity();
+  /// quality.std_dev_deg and quality.num_poses when the file has them (a result YAML does; a
+  /// truth file does not).
+  std::optional<Eigen::Vector3d> std_dev_deg;
+  int num_poses = 0;
 };
 
 /// Reads R_cam_imu (quaternion_xyzw, else matrix) from a result YAML. Throws InputError naming the

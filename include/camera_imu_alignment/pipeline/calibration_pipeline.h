@@ -58,6 +58,7 @@
 #include "camera_imu_alignment/inertial/magnetometer.h"
 #include "camera_imu_alignment/inertial/stationary_detector.h"
 #include "camera_imu_alignment/pipeline/input_rejections.h"
+#include "camera_imu_alignment/pipeline/sample_sink.h"
 #include "camera_imu_alignment/solver/alignment_solver.h"
 #include "camera_imu_alignment/solver/pose_window.h"
 #include "camera_imu_alignment/vision/camera_model.h"
@@ -65,21 +66,6 @@
 #include "camera_imu_alignment/vision/target_detector.h"
 
 namespace camera_imu_alignment {
-
-/// One camera frame: an image converted to mono8 by the caller (ROS wrapper / bag reader), or a
-/// camera orientation given from elsewhere.
-struct CameraFrame {
-  double stamp_s = 0.0;
-  cv::Mat mono8;  ///< CV_8UC1; unused when R_target_cam is given
-  /// The camera orientation when it comes from elsewhere (the user's own detector, motion capture:
-  /// the nodelet's camera_pose topic): then no image and no detection are needed. Use either
-  /// images or given orientations in one pipeline, not both (they share the stamp order).
-  std::optional<Eigen::Matrix3d> R_target_cam;
-};
-
-enum class ImuOrientationSource { kJoint, kAuto, kMagnetometer, kMessage };
-const char* toString(ImuOrientationSource source);
-bool parseImuOrientationSource(const std::string& text, ImuOrientationSource* source);
 
 struct PipelineSettings {
   StationaryDetectorSettings stationary;
@@ -104,6 +90,9 @@ struct PipelineSettings {
   double max_gyro_span_s = 120.0;      ///< longer motion between poses breaks the gyro chain
   double frame_queue_s = 3.0;          ///< frames older than the IMU by more are dropped (no IMU)
   double accel_weight = 0.9;           ///< attitudeFromAccelMag
+  /// Solve after every new pose and report through on_result (calibrate_bag's own use). The
+  /// online calibrator turns it off and solves snapshots of the window itself (snapshot()).
+  bool solve_after_each_pose = true;
   /// Returns an empty string when usable, else the first unusable setting, named by its key in
   /// config/default.yaml.
   std::string validate() const;
@@ -148,6 +137,18 @@ struct RejectedPose {
   std::string reason;  ///< "target seen in 1 frame (2 needed)", "camera spread 0.8 deg", ...
 };
 
+/// A copy of the window, to be solved away from the pipeline (solveWindow), e.g. on a worker
+/// thread while samples keep arriving.
+struct WindowSnapshot {
+  RotationPairs pairs;            ///< PoseWindow::makePairs
+  JointProblem joint;             ///< the joint estimator's problem (imu_orientation: joint)
+  std::vector<int> pose_indices;  ///< StationaryPose::index of each window pose, oldest first
+};
+
+/// The solve of CalibrationPipeline::solve(): the pair estimators, then (imu_orientation: joint)
+/// the joint estimate started from the pair estimate. Pure: no pipeline state.
+AlignmentResult solveWindow(const WindowSnapshot& window, const PipelineSettings& settings);
+
 struct PipelineCallbacks {
   std::function<void(const StationaryPose&)> on_pose;
   std::function<void(const RejectedPose&)> on_pose_rejected;
@@ -165,7 +166,7 @@ struct PipelineBufferSizes {
   std::size_t poses = 0, rests = 0, rejected_rests = 0, window = 0;
 };
 
-class CalibrationPipeline {
+class CalibrationPipeline : public SampleSink {
  public:
   /// poses(), segments() and rejectedPoses() keep the newest this many entries (a node running
   /// for days must not grow); the totals count all.
@@ -176,23 +177,30 @@ class CalibrationPipeline {
                       PipelineCallbacks callbacks = {});
   ~CalibrationPipeline();
 
-  void addImu(const ImuSample& sample);
-  void addMagnetic(const MagneticSample& sample);
+  void addImu(const ImuSample& sample) override;
+  void addMagnetic(const MagneticSample& sample) override;
   /// Sets or replaces the intrinsics (validated; a bad one is counted and ignored).
-  bool setCameraIntrinsics(const CameraIntrinsics& intrinsics);
-  void addFrame(const CameraFrame& frame);
+  bool setCameraIntrinsics(const CameraIntrinsics& intrinsics) override;
+  void addFrame(const CameraFrame& frame) override;
   /// Counts an input refused before it reached the pipeline (a ROS message without a stamp, an
   /// image that cannot be converted, ...) and reports it through on_reject like its own.
-  void rejectInput(RejectReason reason, InputStream stream, const std::string& detail);
+  void rejectInput(RejectReason reason, InputStream stream, const std::string& detail) override;
+  ImuOrientationSource imuOrientationSource() const override;
   /// End of data: closes the rest in progress and processes the queued frames.
   void finish();
-  /// Solves on the current window (also done automatically after every new pose).
+  /// Solves on the current window (also done automatically after every new pose unless
+  /// solve_after_each_pose is false).
   AlignmentResult solve() const;
+  /// A copy of the window for solveWindow.
+  WindowSnapshot snapshot() const;
   /// Forgets all data (poses, window, buffers; counts kept unless clear_counts); the camera
   /// intrinsics stay. Not from a callback.
   void reset(bool clear_counts = false);
   /// Keeps only the newest `count` poses in the solver's window (a remount); callbacks may call it.
   void keepNewestPoses(std::size_t count);
+  /// Keeps the window's poses with StationaryPose::index >= `pose_index` (a remount found by
+  /// index, which stays valid while newer poses arrive).
+  void keepPosesFrom(int pose_index);
   std::size_t windowSize() const;  ///< poses in the solver's window
 
   const std::vector<StationaryPose>& poses() const;  ///< the newest kHistoryLimit poses

@@ -31,7 +31,7 @@
 #include <optional>
 #include <string>
 
-#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/pipeline/sample_sink.h"
 
 namespace camera_imu_alignment {
 
@@ -42,8 +42,7 @@ class MessageInput {
  public:
   /// `pipeline` must outlive this object. `notice` receives one-time remarks about the inputs
   /// (frame ids); may be empty.
-  explicit MessageInput(CalibrationPipeline* pipeline,
-                        std::function<void(const std::string&)> notice = {});
+  explicit MessageInput(SampleSink* pipeline, std::function<void(const std::string&)> notice = {});
 
   void addImu(const sensor_msgs::Imu& msg);
   void addMagnetic(const sensor_msgs::MagneticField& msg);
@@ -98,7 +97,7 @@ class MessageInput {
   void lookUpMagnetometerRotation();
   bool waitingForRotation() const;
 
-  CalibrationPipeline* pipeline_;
+  SampleSink* pipeline_;
   std::function<void(const std::string&)> notice_;
   std::string imu_frame_, mag_frame_, camera_frame_;
   std::string noted_frame_pair_;  ///< IMU and magnetometer frames last noted as different

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/pipeline/online_types.h"
 #include "camera_imu_alignment/pipeline/pipeline_config.h"
 
 namespace camera_imu_alignment {
@@ -21,16 +22,8 @@ struct WrapperSettings {
   /// (resolvePaths expands it), so ~save works out of the box.
   std::string output_file = "~/.ros/camera_imu_alignment.yaml";
   bool load_on_start = true;  ///< broadcast output_file's calibration at start if it exists
-  // Quality gates: an estimate is broadcast only when observable and all of these hold.
-  int min_poses = 3;              ///< stationary poses in the window
-  double max_residual_deg = 1.0;  ///< RMS pair residual (deg)
-  double max_std_dev_deg = 0.5;   ///< largest 1-sigma (deg)
-  double min_change_deg = 0.01;   ///< re-broadcast only when the estimate moved more (deg)
-  bool manual_capture = false;    ///< poses only from rests during which ~capture_pose was called
-  // Remount: this many consecutive new poses whose pairs with the window disagree with the
-  // broadcast estimate by more than remount_residual_deg (RMS) restart the window from them.
-  int remount_poses = 3;
-  double remount_residual_deg = 1.5;
+  /// The calibrator's gates, change detection and capture policy (its keys: online_config.h).
+  OnlineSettings online;
   double status_period_s = 1.0;  ///< ~status is also published this often (s)
   /// image_transport's own parameter: "raw", or "compressed" for CompressedImage topics.
   std::string image_transport = "raw";
@@ -46,7 +39,8 @@ std::string expandHome(const std::string& path);
 /// (a relative output_file: where it will be written).
 std::vector<std::string> resolvePaths(WrapperSettings* settings);
 
-/// The wrapper's own keys (the pipeline's are pipelineConfigKeys()).
+/// The wrapper's own keys (the calibrator's are onlineConfigKeys(), the pipeline's
+/// pipelineConfigKeys()).
 const std::vector<std::string>& wrapperKeys();
 
 /// Reads the private parameters of `private_nh`: wrapper keys into `wrapper`, pipeline keys into

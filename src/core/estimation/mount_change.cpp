@@ -33,6 +33,21 @@ double fisherUpperTail(double f, int d1, int d2) {
   return boost::math::cdf(boost::math::complement(boost::math::fisher_f(d1, d2), f));
 }
 
+namespace {
+
+/// max_k norm_k / max(2, 3 x median norm): above 1, some pose is not fitted (in sigma units,
+/// relative to the typical pose, so that a unit whose noise the priors understate is judged by
+/// its own scale).
+double worstPoseMisfit(std::vector<double> norms) {
+  if (norms.empty()) return 0.0;
+  const double worst = *std::max_element(norms.begin(), norms.end());
+  std::nth_element(norms.begin(), norms.begin() + norms.size() / 2, norms.end());
+  const double median = norms[norms.size() / 2];
+  return worst / std::max(2.0, 3.0 * median);
+}
+
+}  // namespace
+
 MountChangeTest testMountChange(const JointProblem& problem, const JointResult& one_mount,
                                 const JointSettings& joint_settings,
                                 const MountChangeSettings& settings) {
@@ -63,7 +78,9 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
       c.p_value = fisherUpperTail(c.statistic / std::max(1, c.dof) / scale, c.dof, two.dof);
       c.change_deg =
           rad2deg(rotationAngle(two.R_cam_imu.transpose() * *two.R_cam_imu_after_change));
-      if (best < 0 || c.statistic > test.candidates[best].statistic) {
+      c.worst_pose_misfit = worstPoseMisfit(two.pose_residual_norm);
+      c.fits_every_pose = c.worst_pose_misfit <= 1.0;
+      if (c.fits_every_pose && (best < 0 || c.statistic > test.candidates[best].statistic)) {
         best = static_cast<int>(test.candidates.size());
         test.R_cam_imu_before = two.R_cam_imu;
         test.R_cam_imu_after = *two.R_cam_imu_after_change;
@@ -72,7 +89,7 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
     test.candidates.push_back(c);
   }
   if (best < 0) {
-    test.message = "the two-mount solves failed";
+    test.message = "one mount: no two-mount split fits every pose";
     return test;
   }
   const MountChangeCandidate& chosen = test.candidates[best];

@@ -174,6 +174,15 @@ StoredCalibration readResultYaml(const std::string& path) {
     } else {
       throw InputError(path + ": R_cam_imu has neither quaternion_xyzw nor matrix");
     }
+    const YAML::Node quality = root["quality"];
+    if (quality && quality["std_dev_deg"]) {
+      const auto v = quality["std_dev_deg"].as<std::vector<double>>();
+      if (v.size() == 3 && std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]) &&
+          v[0] >= 0 && v[1] >= 0 && v[2] >= 0) {
+        stored.std_dev_deg = Eigen::Vector3d(v[0], v[1], v[2]);
+      }
+    }
+    if (quality && quality["num_poses"]) stored.num_poses = quality["num_poses"].as<int>();
   } catch (const YAML::Exception& e) {
     throw InputError(path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }

@@ -376,6 +376,21 @@ void CalibrationPipeline::finish() {
 
 AlignmentResult CalibrationPipeline::solve() const { return impl_->solve(); }
 
+WindowSnapshot CalibrationPipeline::snapshot() const { return impl_->snapshot(); }
+
+ImuOrientationSource CalibrationPipeline::imuOrientationSource() const {
+  return impl_->settings.imu_orientation;
+}
+
+void CalibrationPipeline::keepPosesFrom(int pose_index) {
+  const std::size_t in_window = std::min(impl_->poses.size(), impl_->window.size());
+  std::size_t keep = 0;
+  for (std::size_t i = impl_->poses.size() - in_window; i < impl_->poses.size(); ++i) {
+    if (impl_->poses[i].index >= pose_index) ++keep;
+  }
+  keepNewestPoses(keep);
+}
+
 void CalibrationPipeline::reset(bool clear_counts) {
   const RejectionCounts counts = impl_->rejections;
   const std::uint64_t n_imu = impl_->num_imu, n_mag = impl_->num_mag, n_frames = impl_->num_frames,

@@ -106,6 +106,7 @@ struct CalibrationPipeline::Impl {
                                        const SegmentField& field);
   void solveAndReport();
   AlignmentResult solve() const;
+  WindowSnapshot snapshot() const;
 };
 
 }  // namespace camera_imu_alignment

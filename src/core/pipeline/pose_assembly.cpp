@@ -329,15 +329,31 @@ void CalibrationPipeline::Impl::acceptPose(const StationaryPose& pose,
   orientation.group = pose.group;
   window.add(orientation);
   if (callbacks.on_pose) callbacks.on_pose(pose);
-  if (static_cast<int>(window.size()) >= settings.min_poses_to_solve) solveAndReport();
+  if (settings.solve_after_each_pose &&
+      static_cast<int>(window.size()) >= settings.min_poses_to_solve) {
+    solveAndReport();
+  }
 }
 
 AlignmentResult CalibrationPipeline::Impl::solve() const {
-  const RotationPairs pairs = window.makePairs();
+  return solveWindow(snapshot(), settings);
+}
+
+WindowSnapshot CalibrationPipeline::Impl::snapshot() const {
+  WindowSnapshot out;
+  out.pairs = window.makePairs();
+  if (settings.imu_orientation == ImuOrientationSource::kJoint) out.joint = joint_window.problem();
+  const std::size_t first = poses.size() - std::min(poses.size(), window.size());
+  for (std::size_t i = first; i < poses.size(); ++i) out.pose_indices.push_back(poses[i].index);
+  return out;
+}
+
+AlignmentResult solveWindow(const WindowSnapshot& window, const PipelineSettings& settings) {
+  const RotationPairs& pairs = window.pairs;
   if (pairs.empty()) {
     AlignmentResult result;
     result.status = SolveStatus::kBadInput;
-    result.message = "no pairs yet: " + std::to_string(window.size()) +
+    result.message = "no pairs yet: " + std::to_string(window.pose_indices.size()) +
                      " stationary pose(s) in the window, at least 2 of one group needed";
     return result;
   }
@@ -347,12 +363,11 @@ AlignmentResult CalibrationPipeline::Impl::solve() const {
     return result;
   }
   // The joint estimate, started from the pair solve.
-  const JointResult joint =
-      JointEstimator(settings.joint).solve(joint_window.problem(), result.R_cam_imu);
+  const JointResult joint = JointEstimator(settings.joint).solve(window.joint, result.R_cam_imu);
   if (joint.ok) {
     result.R_cam_imu = joint.R_cam_imu;
     result.quality.std_dev_deg = joint.std_dev_deg;
-    result.message = "joint estimate over " + std::to_string(joint_window.size()) +
+    result.message = "joint estimate over " + std::to_string(window.joint.poses.size()) +
                      " poses: chi2/dof " + fmt(joint.dof > 0 ? joint.chi2 / joint.dof : 0.0) +
                      ", 1-sigma [" + fmt(joint.std_dev_deg.x(), 4) + " " +
                      fmt(joint.std_dev_deg.y(), 4) + " " + fmt(joint.std_dev_deg.z(), 4) +

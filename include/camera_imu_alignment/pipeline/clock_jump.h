@@ -1,6 +1,6 @@
-// Clock jumps back on the nodelet's inputs: a bag played with --loop, a restarted simulation clock.
-// Judged per input, because a camera's stamps may lag the IMU's by its latency (tens of ms, or a
-// second for a slow driver) without the clock having jumped. No ROS type; unit-tested alone.
+// Clock jumps back on the calibrator's inputs: a bag played with --loop, a restarted simulation
+// clock. Judged per input, because a camera's stamps may lag the IMU's by its latency (tens of ms,
+// or a second for a slow driver) without the clock having jumped. No ROS type; unit-tested alone.
 #pragma once
 
 #include <map>

@@ -1,0 +1,47 @@
+// When a new estimate replaces what the static tf says: the calibrator's quality gates as a pure
+// function (no ROS, no state), unit-tested on its own.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+
+#include "camera_imu_alignment/pipeline/online_types.h"
+#include "camera_imu_alignment/solver/alignment_solver.h"
+
+namespace camera_imu_alignment {
+
+enum class GateDecision {
+  kReject,     ///< fails a quality gate: state collecting / not_observable
+  kKeep,       ///< good, but not better than or not different from what is broadcast
+  kBroadcast,  ///< broadcast (and save) it
+};
+/// "reject", "keep", "broadcast".
+const char* toString(GateDecision decision);
+
+struct GateOutcome {
+  GateDecision decision = GateDecision::kReject;
+  std::string why;  ///< for kReject and kKeep: the gate, with its numbers and parameter
+};
+
+/// The gates in order:
+///   solved and observable; finite; at least min_poses in the window;
+///   joint estimate (imu_orientation: joint): it succeeded and is consistent (chi-square p-value
+///     >= consistency_level); pair modes: RMS pair residual <= max_residual_deg;
+///   largest 1-sigma <= max_std_dev_deg;
+/// then against what is broadcast:
+///   no silent regression: an estimate with a larger 1-sigma from no more poses than the broadcast
+///     one is kept back, unless `fresh_start` (after a remount or a reset the old estimate is not
+///     a reference) or it differs significantly from the broadcast one (the mount changed while
+///     nothing was watching: their difference is judged against both covariances at
+///     remount.level);
+///   min_change_deg: a change smaller than that is not re-broadcast.
+GateOutcome judgeEstimate(const AlignmentResult& result, std::size_t window_poses,
+                          const OnlineSettings& settings,
+                          const std::optional<BroadcastEstimate>& broadcast, bool fresh_start);
+
+/// Chi-square (3 dof) p-value of the difference between an estimate and the broadcast one under
+/// their summed covariances; 1 when the broadcast one has no covariance.
+double differenceSignificance(const AlignmentResult& result, const BroadcastEstimate& broadcast);
+
+}  // namespace camera_imu_alignment

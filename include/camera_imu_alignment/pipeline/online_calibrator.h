@@ -1,0 +1,138 @@
+// The online calibrator: everything the nodelet decides, without ROS. It owns the calibration
+// pipeline (samples -> stationary poses -> window), solves the window (the paper's two-step, the
+// optimal pair estimate and the joint maximum-likelihood estimate), tests the window for a mount
+// change, applies the quality gates (broadcast_gate.h) and keeps the state. Data flow one way:
+// samples in, events out (OnlineCallbacks). calibrate_bag and the nodelet both drive it, so both
+// give the same answer on the same recording.
+//
+// Solving runs on a worker thread when OnlineSettings::threaded (the nodelet: a 30-pose window
+// takes tens of ms, the change test a few solves more) so that the sample calls stay short; the
+// newest request wins. Results are applied, and events emitted, on the caller's thread inside the
+// sample calls or poll(): call every method from one thread. Without threading (calibrate_bag,
+// tests) a solve runs inside the sample call that completed a pose.
+//
+// Remount (a mount change) is found in two ways:
+//   joint estimate (imu_orientation: joint): after every solve the window is tested for a change
+//     point among its newest poses (estimation/mount_change.h), whether or not anything was
+//     broadcast; when found, the window restarts from the poses after the change and the next
+//     estimate is judged without the old one as a reference.
+//   pair modes: remount_poses consecutive new poses whose pairs disagree with the broadcast
+//     estimate by more than remount_residual_deg restart the window from them.
+// A clock jump back (a bag loop, a restarted simulation) clears the window and the buffers; the
+// broadcast estimate stays.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "camera_imu_alignment/pipeline/broadcast_gate.h"
+#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/pipeline/clock_jump.h"
+#include "camera_imu_alignment/pipeline/online_types.h"
+#include "camera_imu_alignment/pipeline/sample_sink.h"
+
+namespace camera_imu_alignment {
+
+/// A solve of the window and what the gates made of it.
+struct EstimateEvent {
+  AlignmentResult result;
+  GateOutcome gate;
+  std::size_t window_poses = 0;  ///< poses the estimate used
+  bool forced = false;           ///< broadcast on request although a gate failed
+  std::optional<MountChangeTest> mount_test;
+};
+
+/// A mount change found.
+struct RemountEvent {
+  int first_pose_index = 0;    ///< StationaryPose::index of the first pose of the new mount
+  double change_deg = 0;       ///< between the two mounts' estimates (0 when unknown: pair modes)
+  std::size_t poses_kept = 0;  ///< poses of the new mount left in the window
+  std::string message;
+};
+
+struct OnlineCallbacks {
+  std::function<void(const StationaryPose&)> on_pose;
+  /// A rest that did not become a pose; the reason says "not armed" for manual capture.
+  std::function<void(const RejectedPose&)> on_pose_rejected;
+  std::function<void(RejectReason, InputStream, const std::string&)> on_reject;
+  std::function<void(const EstimateEvent&)> on_estimate;
+  /// The static tf must say this now (and the file be saved when source is "estimated").
+  std::function<void(const BroadcastEstimate&)> on_broadcast;
+  std::function<void(const RemountEvent&)> on_remount;
+  std::function<void(CalibrationState, const std::string&)> on_state;
+  /// Time jumped back on `stream` by jump_s (s): window and buffers cleared.
+  std::function<void(double jump_s, InputStream stream)> on_clock_jump;
+};
+
+/// The answer of calibrateNow.
+struct CalibrateOutcome {
+  AlignmentResult result;
+  GateOutcome gate;
+  bool broadcast = false;            ///< it is now what the tf says
+  std::string not_broadcast_reason;  ///< "" when broadcast
+  std::size_t window_poses = 0;
+};
+
+class OnlineCalibrator : public SampleSink {
+ public:
+  /// Throws std::invalid_argument when a setting is unusable (named by its key).
+  OnlineCalibrator(const TargetDescription& target, const PipelineSettings& pipeline_settings,
+                   const OnlineSettings& settings, OnlineCallbacks callbacks);
+  ~OnlineCalibrator() override;  ///< stops the worker (a running solve finishes first)
+
+  // --- samples (each also applies finished solves)
+  void addImu(const ImuSample& sample) override;
+  void addMagnetic(const MagneticSample& sample) override;
+  bool setCameraIntrinsics(const CameraIntrinsics& intrinsics) override;
+  void addFrame(const CameraFrame& frame) override;
+  void rejectInput(RejectReason reason, InputStream stream, const std::string& detail) override;
+  ImuOrientationSource imuOrientationSource() const override;
+  /// End of data (or the IMU stopped): closes the rest in progress.
+  void finish();
+  /// Applies finished solves (threaded); call periodically.
+  void poll();
+  /// Waits for the worker to finish what it has, then applies it (tests, calibrate_bag, shutdown).
+  void waitForSolves();
+
+  // --- requests
+  /// Solves the window now on the caller's thread and applies the gates; `force` broadcasts an
+  /// estimate that fails a gate (not one that does not exist: bad input, not observable).
+  CalibrateOutcome calibrateNow(bool force);
+  /// Forgets the window, the buffers, the latest estimate and the remount count; the broadcast
+  /// estimate stays (as the tf does) but is no longer a reference for the gates.
+  void reset();
+  /// A saved calibration: broadcast it (on_broadcast) and use it as the gates' reference.
+  void loadBroadcast(const BroadcastEstimate& estimate);
+  /// manual_capture: the current (or next) rest becomes a pose.
+  void armCapture();
+  /// Whether camera frames are wanted now (manual_capture: only while armed).
+  bool wantsFrames() const;
+
+  // --- state
+  CalibrationState state() const;
+  const std::string& stateMessage() const;
+  const std::optional<EstimateEvent>& lastEstimate() const;
+  const std::optional<BroadcastEstimate>& broadcast() const;
+  const std::optional<StationaryPose>& lastPose() const;
+  int remounts() const;
+  /// Which rotation would most improve the IMU parameters still held at their priors ("" when
+  /// nothing is held or there is no joint estimate).
+  std::string imuGuidance() const;
+  /// The camera axis to rotate about next: the pair solve's least excited axis while R_cam_imu is
+  /// not determined, else the axis that would calibrate the held IMU parameters.
+  Eigen::Vector3d rotateAboutCam() const;
+  /// Newest stamp on any input (s), -1 before the first.
+  double newestStamp() const;
+  const CalibrationPipeline& pipeline() const;
+  const OnlineSettings& settings() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace camera_imu_alignment

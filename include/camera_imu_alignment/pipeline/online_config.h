@@ -1,0 +1,31 @@
+// OnlineSettings from the same flat `key: value` map as the pipeline's settings
+// (config/default.yaml documents every key): the nodelet and calibrate_bag --config read one file.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/pipeline/online_types.h"
+#include "camera_imu_alignment/pipeline/setting_keys.h"
+
+namespace camera_imu_alignment {
+
+/// The calibrator's keys (gates, change detection, capture), in documentation order.
+const std::vector<SettingKey<OnlineSettings>>& onlineKeys();
+const std::vector<std::string>& onlineConfigKeys();
+
+/// Reads a YAML file of `key: value` pairs over both settings (absent keys keep their value):
+/// each key is the calibrator's or else the pipeline's; keys in `ignored_keys` (the ROS wrapper's:
+/// topics, frames, paths) are skipped. Throws InputError naming the file and key on an unknown
+/// key, a wrong type, a value out of range or an unusable combination.
+void loadCalibrationConfig(const std::string& path, PipelineSettings* pipeline,
+                           OnlineSettings* online, const std::vector<std::string>& ignored_keys);
+/// Same from a parsed map; `source` names it in messages. `handled(name, value)` may take a key
+/// first (the ROS wrapper's own) and return true.
+void parseCalibrationConfig(
+    const YAML::Node& root, const std::string& source, PipelineSettings* pipeline,
+    OnlineSettings* online,
+    const std::function<bool(const std::string&, const YAML::Node&)>& handled = {});
+
+}  // namespace camera_imu_alignment

@@ -1,0 +1,68 @@
+// Settings, state and records of the online calibrator (online_calibrator.h), shared with the
+// broadcast gate (broadcast_gate.h) and the ROS adapter. No ROS type.
+#pragma once
+
+#include <Eigen/Core>
+#include <limits>
+#include <optional>
+#include <string>
+
+#include "camera_imu_alignment/estimation/mount_change.h"
+#include "camera_imu_alignment/solver/alignment_solver.h"
+
+namespace camera_imu_alignment {
+
+/// The calibrator's state; toString() gives AlignmentStatus's constants.
+enum class CalibrationState {
+  kWaitingForData,  ///< no IMU samples or no camera data yet
+  kCollecting,      ///< data flowing; too few poses or the quality gates not met
+  kCalibrated,      ///< an estimate passed the gates and is broadcast (or one was loaded)
+  kNotObservable,   ///< the poses so far rotate about one axis only
+  kRecalibrating,   ///< the mount changed: the window restarted from the poses after the change
+};
+/// "waiting_for_data", "collecting", "calibrated", "not_observable", "recalibrating".
+const char* toString(CalibrationState state);
+
+/// Quality gates, change detection and capture policy (config/default.yaml documents each key).
+struct OnlineSettings {
+  int min_poses = 3;  ///< stationary poses in the window before anything is broadcast
+  /// Largest 1-sigma (deg) of a broadcast estimate: the joint estimate's own covariance, scaled
+  /// by chi2/dof when the residuals exceed their noise.
+  double max_std_dev_deg = 0.5;
+  /// Chi-square test of the joint estimate: its p-value must be at least this (probability of
+  /// refusing a correct estimate); a smaller p means the data do not fit one mount with the
+  /// modelled noise.
+  double consistency_level = 1e-3;
+  /// Pair modes only (imu_orientation other than joint, which has the chi-square test instead):
+  /// the RMS pair residual (deg) a broadcast estimate may have.
+  double max_residual_deg = 1.0;
+  double min_change_deg = 0.01;  ///< re-broadcast only when the estimate moved more (deg)
+  bool manual_capture = false;   ///< poses only from rests during which capture was armed
+  /// Change-point test of the joint estimate (remount_level, remount_max_poses_after, ...).
+  MountChangeSettings remount;
+  /// Pair modes only: this many consecutive new poses whose pairs disagree with the broadcast
+  /// estimate by more than remount_residual_deg (RMS) restart the window from them.
+  int remount_poses = 3;
+  double remount_residual_deg = 1.5;
+  /// Solve on a worker thread (the nodelet); false: on the caller's thread (calibrate_bag, tests).
+  bool threaded = true;
+  /// "" when usable, else the first unusable setting named by its key.
+  std::string validate() const;
+};
+
+/// What the static tf says.
+struct BroadcastEstimate {
+  Eigen::Matrix3d R_cam_imu = Eigen::Matrix3d::Identity();
+  /// 1-sigma about the camera axes (deg); infinite when unknown (a file without it).
+  Eigen::Vector3d std_dev_deg = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  /// Its covariance (rad^2, left perturbation, camera axes) when known: the significance of a
+  /// difference to a new estimate.
+  std::optional<Eigen::Matrix3d> covariance_rad2;
+  int poses = 0;       ///< poses behind it
+  std::string source;  ///< "estimated" (this run) or "loaded: <file>"
+  /// The estimate itself when estimated here: what is saved.
+  std::optional<AlignmentResult> result;
+  double maxStdDevDeg() const { return std_dev_deg.maxCoeff(); }
+};
+
+}  // namespace camera_imu_alignment

@@ -1,0 +1,80 @@
+// The quality gates (broadcast_gate.h).
+#include "camera_imu_alignment/pipeline/broadcast_gate.h"
+
+#include <Eigen/LU>
+#include <boost/math/distributions/chi_squared.hpp>
+#include <cmath>
+#include <sstream>
+
+#include "camera_imu_alignment/solver/rotation_math.h"
+
+namespace camera_imu_alignment {
+
+const char* toString(GateDecision decision) {
+  switch (decision) {
+    case GateDecision::kReject:
+      return "reject";
+    case GateDecision::kKeep:
+      return "keep";
+    case GateDecision::kBroadcast:
+      return "broadcast";
+  }
+  return "?";
+}
+
+double differenceSignificance(const AlignmentResult& result, const BroadcastEstimate& broadcast) {
+  if (!broadcast.covariance_rad2 || !result.joint || !result.joint->ok) return 1.0;
+  const Eigen::Vector3d difference = logSO3(result.R_cam_imu * broadcast.R_cam_imu.transpose());
+  const Eigen::Matrix3d covariance = result.joint->covariance_rad2 + *broadcast.covariance_rad2;
+  if (!covariance.allFinite() || !(covariance.determinant() > 0.0)) return 1.0;
+  const double chi2 = difference.dot(covariance.inverse() * difference);
+  if (!std::isfinite(chi2)) return 1.0;
+  return boost::math::cdf(boost::math::complement(boost::math::chi_squared(3.0), chi2));
+}
+
+GateOutcome judgeEstimate(const AlignmentResult& r, std::size_t window_poses,
+                          const OnlineSettings& settings,
+                          const std::optional<BroadcastEstimate>& broadcast, bool fresh_start) {
+  GateOutcome out;
+  std::ostringstream why;
+  why.precision(3);
+  const double sigma = r.quality.std_dev_deg.maxCoeff();
+  const bool joint = r.joint.has_value();
+  if (r.status != SolveStatus::kOk) {
+    why << r.message;
+  } else if (!r.R_cam_imu.allFinite() || !r.quality.std_dev_deg.allFinite()) {
+    why << "estimate or 1-sigma not finite";  // never reaches the tf or a file
+  } else if (window_poses < static_cast<std::size_t>(settings.min_poses)) {
+    why << window_poses << " poses in the window, min_poses is " << settings.min_poses;
+  } else if (joint && !r.joint->ok) {
+    why << "the joint estimate failed: " << r.joint->message;
+  } else if (joint && !(r.joint->chi2_p_value >= settings.consistency_level)) {
+    why << "the data do not fit one mount with the modelled noise: chi2/dof "
+        << (r.joint->dof > 0 ? r.joint->chi2 / r.joint->dof : 0.0) << ", p "
+        << r.joint->chi2_p_value << " < consistency_level " << settings.consistency_level
+        << " (IMU errors beyond the imu_prior_* values, a bad pose, or a mount that moved)";
+  } else if (!joint && !(r.quality.residual_rms_deg <= settings.max_residual_deg)) {
+    why << "residual RMS " << r.quality.residual_rms_deg << " deg > max_residual_deg "
+        << settings.max_residual_deg;
+  } else if (!(sigma <= settings.max_std_dev_deg)) {
+    why << "1-sigma " << sigma << " deg > max_std_dev_deg " << settings.max_std_dev_deg
+        << ": more poses, rotated about other axes";
+  } else if (broadcast && !fresh_start && sigma > broadcast->maxStdDevDeg() &&
+             window_poses <= static_cast<std::size_t>(broadcast->poses) &&
+             differenceSignificance(r, *broadcast) >= settings.remount.level) {
+    out.decision = GateDecision::kKeep;
+    why << "1-sigma " << sigma << " deg from " << window_poses
+        << " poses is larger than the broadcast estimate's " << broadcast->maxStdDevDeg()
+        << " deg from " << broadcast->poses << ": kept back (no silent regression)";
+  } else if (broadcast && rad2deg(rotationAngle(broadcast->R_cam_imu.transpose() * r.R_cam_imu)) <=
+                              settings.min_change_deg) {
+    out.decision = GateDecision::kKeep;
+    why << "within min_change_deg " << settings.min_change_deg << " of the broadcast estimate";
+  } else {
+    out.decision = GateDecision::kBroadcast;
+  }
+  out.why = why.str();
+  return out;
+}
+
+}  // namespace camera_imu_alignment

@@ -1,0 +1,450 @@
+// OnlineCalibrator (online_calibrator.h): state, gates, remounts; solving in solve_worker.
+#include "camera_imu_alignment/pipeline/online_calibrator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <stdexcept>
+
+#include "camera_imu_alignment/solver/rotation_math.h"
+#include "camera_imu_alignment/solver/solution_quality.h"
+#include "solve_worker.h"
+
+namespace camera_imu_alignment {
+
+const char* toString(CalibrationState state) {
+  switch (state) {
+    case CalibrationState::kWaitingForData:
+      return "waiting_for_data";
+    case CalibrationState::kCollecting:
+      return "collecting";
+    case CalibrationState::kCalibrated:
+      return "calibrated";
+    case CalibrationState::kNotObservable:
+      return "not_observable";
+    case CalibrationState::kRecalibrating:
+      return "recalibrating";
+  }
+  return "?";
+}
+
+std::string OnlineSettings::validate() const {
+  std::ostringstream out;
+  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (min_poses < 2) {
+    out << "min_poses = " << min_poses << ": must be an integer >= 2";
+  } else if (!positive(max_std_dev_deg)) {
+    out << "max_std_dev_deg = " << max_std_dev_deg << ": must be a finite number > 0";
+  } else if (!(consistency_level > 0.0 && consistency_level < 1.0)) {
+    out << "consistency_level = " << consistency_level << ": must be within (0, 1)";
+  } else if (!positive(max_residual_deg)) {
+    out << "max_residual_deg = " << max_residual_deg << ": must be a finite number > 0";
+  } else if (!(std::isfinite(min_change_deg) && min_change_deg >= 0.0)) {
+    out << "min_change_deg = " << min_change_deg << ": must be a finite number >= 0";
+  } else if (remount_poses < 1) {
+    out << "remount_poses = " << remount_poses << ": must be an integer >= 1";
+  } else if (!positive(remount_residual_deg)) {
+    out << "remount_residual_deg = " << remount_residual_deg << ": must be a finite number > 0";
+  } else {
+    return remount.validate();
+  }
+  return out.str();
+}
+
+struct OnlineCalibrator::Impl {
+  Impl(const TargetDescription& target, const PipelineSettings& pipeline_settings,
+       const OnlineSettings& online, OnlineCallbacks cb, OnlineCalibrator* owner);
+
+  PipelineSettings pipeline_settings;
+  OnlineSettings settings;
+  OnlineCallbacks callbacks;
+  std::unique_ptr<CalibrationPipeline> pipeline;
+  std::unique_ptr<SolveWorker> worker;  ///< when threaded
+  ClockJumpDetector clock;
+
+  std::uint64_t generation = 0;  ///< bumped when the window loses poses: older solves are stale
+  CalibrationState state = CalibrationState::kWaitingForData;
+  std::string message = "waiting for IMU and camera data";
+  std::optional<EstimateEvent> last_estimate;
+  std::optional<BroadcastEstimate> broadcast;
+  std::optional<StationaryPose> last_pose;
+  bool fresh_start = false;    ///< the broadcast estimate is no reference (remount, reset)
+  bool recalibrating = false;  ///< a remount was found and nothing broadcast since
+  int remounts = 0;
+  int inconsistent_poses = 0;  ///< pair modes: consecutive poses off the broadcast estimate
+  bool capture_armed = false;
+
+  bool joint() const { return pipeline_settings.imu_orientation == ImuOrientationSource::kJoint; }
+  void setState(CalibrationState s, const std::string& text) {
+    const bool changed = s != state || text != message;
+    state = s;
+    message = text;
+    if (changed && callbacks.on_state) callbacks.on_state(state, message);
+  }
+  /// waiting_for_data -> collecting once IMU and camera data flow.
+  void refreshWaiting() {
+    if (state != CalibrationState::kWaitingForData) return;
+    if (pipeline->imuSamples() > 0 && (pipeline->hasIntrinsics() || pipeline->frames() > 0)) {
+      setState(CalibrationState::kCollecting, "waiting for stationary poses");
+    }
+  }
+  bool checkClock(double stamp_s, InputStream stream);
+  void onPose(const StationaryPose& pose);
+  void onPoseRejected(const RejectedPose& rejected);
+  void checkPairRemount(const StationaryPose& pose);
+  void requestSolve();
+  void poll();
+  void apply(SolveOutput output);
+  void applyRemount(const SolveOutput& output);
+  void applyEstimate(EstimateEvent event);
+  void doBroadcast(const AlignmentResult& result, std::size_t poses);
+};
+
+OnlineCalibrator::Impl::Impl(const TargetDescription& target,
+                             const PipelineSettings& pipeline_settings_in,
+                             const OnlineSettings& online, OnlineCallbacks cb,
+                             OnlineCalibrator* /*owner*/)
+    : pipeline_settings(pipeline_settings_in), settings(online), callbacks(std::move(cb)) {
+  const std::string error = settings.validate();
+  if (!error.empty()) throw std::invalid_argument(error);
+  pipeline_settings.solve_after_each_pose = false;  // the calibrator solves snapshots itself
+  PipelineCallbacks pc;
+  pc.on_pose = [this](const StationaryPose& p) { onPose(p); };
+  pc.on_pose_rejected = [this](const RejectedPose& r) { onPoseRejected(r); };
+  pc.on_reject = [this](RejectReason reason, InputStream stream, const std::string& detail) {
+    if (callbacks.on_reject) callbacks.on_reject(reason, stream, detail);
+  };
+  pipeline = std::make_unique<CalibrationPipeline>(target, pipeline_settings, pc);
+  if (settings.threaded) worker = std::make_unique<SolveWorker>(pipeline_settings, settings);
+}
+
+bool OnlineCalibrator::Impl::checkClock(double stamp_s, InputStream stream) {
+  const double jump_s = clock.update(toString(stream), stamp_s);
+  if (jump_s <= 0.0) return false;
+  pipeline->reset();
+  ++generation;
+  inconsistent_poses = 0;
+  last_pose.reset();
+  if (callbacks.on_clock_jump) callbacks.on_clock_jump(jump_s, stream);
+  return true;
+}
+
+void OnlineCalibrator::Impl::onPose(const StationaryPose& pose) {
+  last_pose = pose;
+  capture_armed = false;
+  if (callbacks.on_pose) callbacks.on_pose(pose);
+  if (!joint()) checkPairRemount(pose);
+  if (static_cast<int>(pipeline->windowSize()) >= pipeline_settings.min_poses_to_solve) {
+    requestSolve();
+  }
+}
+
+void OnlineCalibrator::Impl::onPoseRejected(const RejectedPose& rejected) {
+  RejectedPose out = rejected;
+  // manual_capture: a rest during which capture was not armed saw no camera data on purpose; the
+  // pipeline's reason ("no camera data") would send the user looking for a fault.
+  if (settings.manual_capture && !capture_armed) {
+    out.reason = "not armed (manual_capture: arm the capture during a rest to make it a pose)";
+  }
+  capture_armed = false;
+  if (callbacks.on_pose_rejected) callbacks.on_pose_rejected(out);
+}
+
+void OnlineCalibrator::Impl::checkPairRemount(const StationaryPose& pose) {
+  if (!broadcast) return;
+  // The new pose's pairs with the rest of the window against the broadcast estimate.
+  const RotationPairs pairs = pipeline->windowPairs();
+  int newest = -1;
+  for (const auto& p : pairs) newest = std::max(newest, p.pose_t);
+  double sum_sq = 0.0;
+  int count = 0;
+  for (const auto& p : pairs) {
+    if (p.pose_t != newest) continue;
+    sum_sq += pairResidual(p, broadcast->R_cam_imu).squaredNorm();
+    ++count;
+  }
+  const double rms_deg = count > 0 ? rad2deg(std::sqrt(sum_sq / count)) : 0.0;
+  inconsistent_poses = rms_deg > settings.remount_residual_deg ? inconsistent_poses + 1 : 0;
+  if (inconsistent_poses < settings.remount_poses) return;
+  const int first_index = pose.index - settings.remount_poses + 1;
+  pipeline->keepNewestPoses(static_cast<std::size_t>(settings.remount_poses));
+  ++generation;
+  ++remounts;
+  inconsistent_poses = 0;
+  recalibrating = fresh_start = true;
+  char text[256];
+  std::snprintf(text, sizeof(text),
+                "mount changed before pose %d: the last %d poses disagree with the broadcast "
+                "estimate by more than remount_residual_deg %.2f deg; window restarted from them",
+                first_index, settings.remount_poses, settings.remount_residual_deg);
+  setState(CalibrationState::kRecalibrating, text);
+  if (callbacks.on_remount) {
+    callbacks.on_remount({first_index, 0.0, pipeline->windowSize(), text});
+  }
+}
+
+void OnlineCalibrator::Impl::requestSolve() {
+  SolveJob job;
+  job.generation = generation;
+  job.window = pipeline->snapshot();
+  job.test_mount_change = joint();
+  if (worker) {
+    worker->submit(std::move(job));
+  } else {
+    apply(runSolveJob(std::move(job), pipeline_settings, settings));
+  }
+}
+
+void OnlineCalibrator::Impl::poll() {
+  if (!worker) return;
+  for (SolveOutput& output : worker->takeFinished()) apply(std::move(output));
+}
+
+void OnlineCalibrator::Impl::apply(SolveOutput output) {
+  if (output.generation != generation) return;  // the window lost poses since: stale
+  if (output.result.status == SolveStatus::kBadInput) return;
+  if (output.mount_test && output.mount_test->detected) {
+    applyRemount(output);
+    return;
+  }
+  EstimateEvent event;
+  event.result = std::move(output.result);
+  event.window_poses = output.window.pose_indices.size();
+  event.mount_test = std::move(output.mount_test);
+  event.gate = judgeEstimate(event.result, event.window_poses, settings, broadcast, fresh_start);
+  applyEstimate(std::move(event));
+}
+
+void OnlineCalibrator::Impl::applyRemount(const SolveOutput& output) {
+  const MountChangeTest& test = *output.mount_test;
+  const int first_index = output.window.pose_indices.at(test.first_pose_after);
+  pipeline->keepPosesFrom(first_index);
+  ++generation;
+  ++remounts;
+  inconsistent_poses = 0;
+  recalibrating = fresh_start = true;
+  char text[320];
+  std::snprintf(text, sizeof(text),
+                "mount changed before pose %d (by %.2f deg; chi-square change test p %.2g < "
+                "remount_level %.2g): window restarted from the %zu poses after it",
+                first_index, test.change_deg, test.p_value, settings.remount.level,
+                pipeline->windowSize());
+  setState(CalibrationState::kRecalibrating, text);
+  if (callbacks.on_remount) {
+    callbacks.on_remount({first_index, test.change_deg, pipeline->windowSize(), text});
+  }
+  if (static_cast<int>(pipeline->windowSize()) >= pipeline_settings.min_poses_to_solve) {
+    requestSolve();
+  }
+}
+
+void OnlineCalibrator::Impl::applyEstimate(EstimateEvent event) {
+  last_estimate = event;
+  if (callbacks.on_estimate) callbacks.on_estimate(event);
+  switch (event.gate.decision) {
+    case GateDecision::kReject:
+      setState(event.result.status == SolveStatus::kNotObservable ? CalibrationState::kNotObservable
+               : recalibrating                                    ? CalibrationState::kRecalibrating
+               : broadcast && !fresh_start                        ? CalibrationState::kCalibrated
+                                                                  : CalibrationState::kCollecting,
+               "estimate not broadcast: " + event.gate.why);
+      return;
+    case GateDecision::kKeep:
+      setState(CalibrationState::kCalibrated, "the broadcast estimate stays: " + event.gate.why);
+      return;
+    case GateDecision::kBroadcast:
+      doBroadcast(event.result, event.window_poses);
+      return;
+  }
+}
+
+void OnlineCalibrator::Impl::doBroadcast(const AlignmentResult& result, std::size_t poses) {
+  BroadcastEstimate b;
+  b.R_cam_imu = result.R_cam_imu;
+  b.std_dev_deg = result.quality.std_dev_deg;
+  if (result.joint && result.joint->ok) b.covariance_rad2 = result.joint->covariance_rad2;
+  b.poses = static_cast<int>(poses);
+  b.source = "estimated";
+  b.result = result;
+  broadcast = b;
+  fresh_start = recalibrating = false;
+  inconsistent_poses = 0;
+  setState(CalibrationState::kCalibrated, result.message);
+  if (callbacks.on_broadcast) callbacks.on_broadcast(b);
+}
+
+// --- public
+
+OnlineCalibrator::OnlineCalibrator(const TargetDescription& target,
+                                   const PipelineSettings& pipeline_settings,
+                                   const OnlineSettings& settings, OnlineCallbacks callbacks)
+    : impl_(std::make_unique<Impl>(target, pipeline_settings, settings, std::move(callbacks),
+                                   this)) {}
+
+OnlineCalibrator::~OnlineCalibrator() = default;
+
+void OnlineCalibrator::addImu(const ImuSample& sample) {
+  impl_->checkClock(sample.stamp_s, InputStream::kImu);
+  impl_->pipeline->addImu(sample);
+  impl_->refreshWaiting();
+  impl_->poll();
+}
+
+void OnlineCalibrator::addMagnetic(const MagneticSample& sample) {
+  impl_->checkClock(sample.stamp_s, InputStream::kMagnetometer);
+  impl_->pipeline->addMagnetic(sample);
+  impl_->poll();
+}
+
+bool OnlineCalibrator::setCameraIntrinsics(const CameraIntrinsics& intrinsics) {
+  const bool ok = impl_->pipeline->setCameraIntrinsics(intrinsics);
+  impl_->refreshWaiting();
+  return ok;
+}
+
+void OnlineCalibrator::addFrame(const CameraFrame& frame) {
+  impl_->checkClock(frame.stamp_s,
+                    frame.R_target_cam ? InputStream::kCameraPose : InputStream::kImage);
+  impl_->pipeline->addFrame(frame);
+  impl_->refreshWaiting();
+  impl_->poll();
+}
+
+void OnlineCalibrator::rejectInput(RejectReason reason, InputStream stream,
+                                   const std::string& detail) {
+  impl_->pipeline->rejectInput(reason, stream, detail);
+}
+
+ImuOrientationSource OnlineCalibrator::imuOrientationSource() const {
+  return impl_->pipeline_settings.imu_orientation;
+}
+
+void OnlineCalibrator::finish() {
+  impl_->pipeline->finish();
+  impl_->poll();
+}
+
+void OnlineCalibrator::poll() { impl_->poll(); }
+
+void OnlineCalibrator::waitForSolves() {
+  if (impl_->worker) impl_->worker->waitIdle();
+  impl_->poll();
+}
+
+CalibrateOutcome OnlineCalibrator::calibrateNow(bool force) {
+  waitForSolves();
+  SolveJob job;
+  job.generation = impl_->generation;
+  job.window = impl_->pipeline->snapshot();
+  const std::size_t poses = job.window.pose_indices.size();
+  SolveOutput output = runSolveJob(std::move(job), impl_->pipeline_settings, impl_->settings);
+  CalibrateOutcome out;
+  out.window_poses = poses;
+  out.result = output.result;
+  if (output.result.status == SolveStatus::kBadInput) {
+    out.not_broadcast_reason = output.result.message;
+    return out;
+  }
+  EstimateEvent event;
+  event.result = output.result;
+  event.window_poses = poses;
+  event.gate =
+      judgeEstimate(event.result, poses, impl_->settings, impl_->broadcast, impl_->fresh_start);
+  out.gate = event.gate;
+  const bool forcible = force && event.gate.decision != GateDecision::kBroadcast &&
+                        event.result.status == SolveStatus::kOk &&
+                        event.result.R_cam_imu.allFinite();
+  if (forcible) {
+    event.forced = true;
+    impl_->last_estimate = event;
+    if (impl_->callbacks.on_estimate) impl_->callbacks.on_estimate(event);
+    impl_->doBroadcast(event.result, poses);
+    impl_->setState(CalibrationState::kCalibrated,
+                    "broadcast on request (force) although: " + event.gate.why);
+  } else {
+    impl_->applyEstimate(event);
+  }
+  out.broadcast = forcible || event.gate.decision == GateDecision::kBroadcast;
+  if (!out.broadcast) {
+    out.not_broadcast_reason =
+        event.gate.why.empty() ? std::string("not broadcast") : event.gate.why;
+  }
+  return out;
+}
+
+void OnlineCalibrator::reset() {
+  if (impl_->worker) impl_->worker->waitIdle();
+  impl_->poll();
+  impl_->pipeline->reset();
+  ++impl_->generation;
+  impl_->last_estimate.reset();
+  impl_->last_pose.reset();
+  impl_->inconsistent_poses = 0;
+  impl_->remounts = 0;
+  impl_->recalibrating = false;
+  impl_->capture_armed = false;
+  impl_->fresh_start = true;  // starting over: the next good estimate replaces the tf
+  impl_->setState(
+      impl_->broadcast ? CalibrationState::kCollecting : CalibrationState::kWaitingForData,
+      "reset: window and buffers cleared" +
+          std::string(impl_->broadcast ? "; the broadcast calibration stays until a new one" : ""));
+}
+
+void OnlineCalibrator::loadBroadcast(const BroadcastEstimate& estimate) {
+  impl_->broadcast = estimate;
+  impl_->fresh_start = false;
+  impl_->setState(CalibrationState::kCalibrated, "calibration " + estimate.source);
+  if (impl_->callbacks.on_broadcast) impl_->callbacks.on_broadcast(estimate);
+}
+
+void OnlineCalibrator::armCapture() { impl_->capture_armed = true; }
+
+bool OnlineCalibrator::wantsFrames() const {
+  return !impl_->settings.manual_capture || impl_->capture_armed;
+}
+
+CalibrationState OnlineCalibrator::state() const { return impl_->state; }
+const std::string& OnlineCalibrator::stateMessage() const { return impl_->message; }
+const std::optional<EstimateEvent>& OnlineCalibrator::lastEstimate() const {
+  return impl_->last_estimate;
+}
+const std::optional<BroadcastEstimate>& OnlineCalibrator::broadcast() const {
+  return impl_->broadcast;
+}
+const std::optional<StationaryPose>& OnlineCalibrator::lastPose() const { return impl_->last_pose; }
+int OnlineCalibrator::remounts() const { return impl_->remounts; }
+double OnlineCalibrator::newestStamp() const { return impl_->clock.newest(); }
+const CalibrationPipeline& OnlineCalibrator::pipeline() const { return *impl_->pipeline; }
+const OnlineSettings& OnlineCalibrator::settings() const { return impl_->settings; }
+
+std::string OnlineCalibrator::imuGuidance() const {
+  if (!impl_->last_estimate || !impl_->last_estimate->result.joint) return "";
+  const JointResult& joint = *impl_->last_estimate->result.joint;
+  if (!joint.ok) return "";
+  std::string held;
+  for (const EstimatedValue& value : joint.parameters) {
+    if (value.estimated) continue;
+    held += (held.empty() ? "" : ", ") + value.name;
+  }
+  if (held.empty()) return "";
+  const Eigen::Vector3d axis_cam = joint.R_cam_imu * joint.suggested_rotation_axis_imu;
+  char text[160];
+  std::snprintf(text, sizeof(text),
+                "; to calibrate them, rotate about the camera axis (%.2f, %.2f, %.2f)",
+                axis_cam.x(), axis_cam.y(), axis_cam.z());
+  return "IMU parameters held at their priors: " + held + text;
+}
+
+Eigen::Vector3d OnlineCalibrator::rotateAboutCam() const {
+  if (!impl_->last_estimate) return Eigen::Vector3d::UnitX();
+  const AlignmentResult& r = impl_->last_estimate->result;
+  const bool determined = r.status == SolveStatus::kOk &&
+                          r.quality.std_dev_deg.maxCoeff() <= impl_->settings.max_std_dev_deg;
+  if (determined && r.joint && r.joint->ok && !imuGuidance().empty()) {
+    return (r.joint->R_cam_imu * r.joint->suggested_rotation_axis_imu).normalized();
+  }
+  return r.quality.excite_axis_cam;
+}
+
+}  // namespace camera_imu_alignment

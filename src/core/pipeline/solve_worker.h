@@ -1,0 +1,58 @@
+// The online calibrator's solves, away from the thread that feeds samples: a job is a snapshot of
+// the window; the newest job waiting replaces an older one (only the latest window matters).
+// Private to the pipeline; not installed.
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/pipeline/online_types.h"
+
+namespace camera_imu_alignment {
+
+struct SolveJob {
+  std::uint64_t generation = 0;  ///< the window's generation when taken (reset, remount, jump)
+  WindowSnapshot window;
+  bool test_mount_change = false;
+};
+
+struct SolveOutput {
+  std::uint64_t generation = 0;
+  WindowSnapshot window;  ///< the job's (pose indices of the estimate)
+  AlignmentResult result;
+  std::optional<MountChangeTest> mount_test;
+};
+
+/// The solve and, for joint estimates, the change-point test.
+SolveOutput runSolveJob(SolveJob job, const PipelineSettings& pipeline,
+                        const OnlineSettings& online);
+
+class SolveWorker {
+ public:
+  SolveWorker(PipelineSettings pipeline, OnlineSettings online);
+  ~SolveWorker();  ///< finishes the running job, drops the waiting one, joins
+  /// Queues `job` in place of any job still waiting.
+  void submit(SolveJob job);
+  /// Finished outputs, oldest first (moved out).
+  std::deque<SolveOutput> takeFinished();
+  /// Blocks until nothing is waiting or running.
+  void waitIdle();
+
+ private:
+  void run();
+  const PipelineSettings pipeline_;
+  const OnlineSettings online_;
+  std::mutex mutex_;
+  std::condition_variable wake_, idle_;
+  std::optional<SolveJob> waiting_;
+  bool running_ = false, stop_ = false;
+  std::deque<SolveOutput> finished_;
+  std::thread thread_;
+};
+
+}  // namespace camera_imu_alignment
