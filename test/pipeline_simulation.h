@@ -158,14 +158,30 @@ inline PipelineRun runPipeline(const simulation::SimulationConfig& config,
 /// A run fed without images: camera orientations given (the truth with `camera_noise_deg` of noise
 /// per axis per frame, at 15 Hz), as through the nodelet's camera_pose topic; optionally the IMU's
 /// own orientation (the truth with 2.5x that noise) in every sample.
-inline std::unique_ptr<CalibrationPipeline> feedWithoutImages(const simulation::SimulationRun& run,
-                                                              const PipelineSettings& settings,
-                                                              double camera_noise_deg,
-                                                              bool imu_orientation = false,
-                                                              unsigned noise_seed = 19) {
+/// The joint estimator's priors for a simulated unit: its grade's spread of the systematic errors
+/// (the consumer defaults for the ideal grade, whose errors are zero).
+inline JointSettings jointSettingsFor(const simulation::SimulationConfig& c) {
+  JointSettings s;
+  const auto& e = c.imu_systematic;
+  if (e.gyro_scale_sigma > 0.0) {
+    s.priors.gyro_scale = e.gyro_scale_sigma;
+    s.priors.gyro_cross_axis = e.gyro_cross_axis_sigma;
+    s.priors.accel_scale = e.accel_scale_sigma;
+    s.priors.accel_cross_axis = e.accel_cross_axis_sigma;
+    s.priors.hard_iron_t = std::max(1e-6, e.mag_hard_iron_sigma);
+    s.priors.soft_iron_scale = s.priors.soft_iron_cross = std::max(0.005, e.mag_soft_iron_sigma);
+  }
+  s.priors.accel_bias_m_s2 = std::max(0.01, 2.0 * c.imu_noise.accelerometer_initial_bias_sigma);
+  return s;
+}
+
+/// Feeds a simulated run to `sink` in stamp order with the camera orientations given (no images):
+/// the true ones jittered by `camera_noise_deg` (1-sigma per axis) at 15 Hz. The caller calls
+/// finish().
+inline void feedSinkWithoutImages(const simulation::SimulationRun& run, SampleSink* sink,
+                                  double camera_noise_deg, bool imu_orientation = false,
+                                  unsigned noise_seed = 19) {
   const Eigen::Matrix3d R_world_target = run.trajectory.R_world_target();
-  auto pipeline = std::make_unique<CalibrationPipeline>(
-      parseTargetYaml(simulation::targetYaml(run.config.target), "target"), settings);
   std::mt19937 rng(noise_seed);
   std::normal_distribution<double> noise(0.0, deg2rad(camera_noise_deg));
   auto jitter = [&](double scale) {
@@ -179,11 +195,11 @@ inline std::unique_ptr<CalibrationPipeline> feedWithoutImages(const simulation::
       if (imu_orientation) {
         sample.q_world_imu = Eigen::Quaterniond(run.trajectory.at(s.t).R_world_imu() * jitter(2.5));
       }
-      pipeline->addImu(sample);
+      sink->addImu(sample);
     }
     while (next_mag < run.mag.size() && run.mag[next_mag].t <= t) {
       const auto& s = run.mag[next_mag++];
-      pipeline->addMagnetic({s.t, s.field});
+      sink->addMagnetic({s.t, s.field});
     }
   };
   for (double t = 0.0; t < run.imu.back().t; t += 1.0 / 15.0) {
@@ -191,9 +207,20 @@ inline std::unique_ptr<CalibrationPipeline> feedWithoutImages(const simulation::
     CameraFrame frame;
     frame.stamp_s = t;
     frame.R_target_cam = R_world_target.transpose() * run.trajectory.at(t).R_world_cam * jitter(1);
-    pipeline->addFrame(frame);
+    sink->addFrame(frame);
   }
   feedUpTo(std::numeric_limits<double>::infinity());
+}
+
+/// A new pipeline fed with feedSinkWithoutImages, finished.
+inline std::unique_ptr<CalibrationPipeline> feedWithoutImages(const simulation::SimulationRun& run,
+                                                              const PipelineSettings& settings,
+                                                              double camera_noise_deg,
+                                                              bool imu_orientation = false,
+                                                              unsigned noise_seed = 19) {
+  auto pipeline = std::make_unique<CalibrationPipeline>(
+      parseTargetYaml(simulation::targetYaml(run.config.target), "target"), settings);
+  feedSinkWithoutImages(run, pipeline.get(), camera_noise_deg, imu_orientation, noise_seed);
   pipeline->finish();
   return pipeline;
 }

@@ -1,11 +1,13 @@
-// The nodelet's broadcast policy (judgeEstimate): quality gates, no silent regression, change
-// threshold. ROS-free: no roscore needed.
+// The calibrator's broadcast policy (judgeEstimate): quality gates (pair residual for pair modes,
+// chi-square consistency for the joint estimate), no silent regression (by 1-sigma and pose
+// count, unless the difference to the broadcast estimate is significant), change threshold.
+// ROS-free.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <limits>
 
-#include "camera_imu_alignment/ros/broadcast_gate.h"
+#include "camera_imu_alignment/pipeline/broadcast_gate.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {
@@ -21,10 +23,36 @@ AlignmentResult goodResult(double sigma_deg,
   return r;
 }
 
+/// A joint estimate with isotropic 1-sigma and the given chi-square p-value.
+AlignmentResult jointResult(double sigma_deg, const Eigen::Matrix3d& R, double p_value) {
+  AlignmentResult r = goodResult(sigma_deg, R);
+  r.quality.std_dev_deg = Eigen::Vector3d::Constant(sigma_deg);
+  r.quality.residual_rms_deg = 3.0;  // the pair residual: not a gate for the joint estimate
+  JointResult joint;
+  joint.ok = true;
+  joint.R_cam_imu = R;
+  joint.covariance_rad2 = std::pow(deg2rad(sigma_deg), 2) * Eigen::Matrix3d::Identity();
+  joint.chi2 = 50;
+  joint.dof = 50;
+  joint.chi2_p_value = p_value;
+  r.joint = joint;
+  return r;
+}
+
+BroadcastEstimate broadcastOf(const AlignmentResult& r, int poses) {
+  BroadcastEstimate b;
+  b.R_cam_imu = r.R_cam_imu;
+  b.std_dev_deg = r.quality.std_dev_deg;
+  if (r.joint) b.covariance_rad2 = r.joint->covariance_rad2;
+  b.poses = poses;
+  b.source = "estimated";
+  return b;
+}
+
 Eigen::Matrix3d turned(double deg) { return expSO3(Eigen::Vector3d(0, 0, deg2rad(deg))); }
 
 TEST(BroadcastGate, QualityGatesInOrder) {
-  const WrapperSettings s;  // min_poses 3, max_residual 1 deg, max_std_dev 0.5 deg
+  const OnlineSettings s;  // min_poses 3, max_residual 1 deg, max_std_dev 0.5 deg
   EXPECT_EQ(judgeEstimate(goodResult(0.05), 3, s, std::nullopt, false).decision,
             GateDecision::kBroadcast);
   AlignmentResult not_observable = goodResult(0.05);
@@ -46,29 +74,65 @@ TEST(BroadcastGate, QualityGatesInOrder) {
   EXPECT_EQ(judgeEstimate(nan, 5, s, std::nullopt, false).decision, GateDecision::kReject);
 }
 
-TEST(BroadcastGate, NoSilentRegressionUnlessTheMountChanged) {
-  const WrapperSettings s;
-  const PublishedEstimate published{turned(0.0), 0.05};
-  // Less precise than what is broadcast: kept back ...
-  const GateOutcome worse = judgeEstimate(goodResult(0.08, turned(0.2)), 10, s, published, false);
+TEST(BroadcastGate, JointEstimateJudgedByChiSquareNotByThePairResidual) {
+  const OnlineSettings s;  // consistency_level 1e-3
+  // A large pair residual (a consumer gyro chain) does not matter for a consistent joint estimate.
+  EXPECT_EQ(judgeEstimate(jointResult(0.05, turned(0), 0.3), 10, s, std::nullopt, false).decision,
+            GateDecision::kBroadcast);
+  // An inconsistent one is refused, naming the test and the parameter.
+  const GateOutcome inconsistent =
+      judgeEstimate(jointResult(0.05, turned(0), 1e-5), 10, s, std::nullopt, false);
+  EXPECT_EQ(inconsistent.decision, GateDecision::kReject);
+  EXPECT_NE(inconsistent.why.find("consistency_level"), std::string::npos) << inconsistent.why;
+  AlignmentResult failed = jointResult(0.05, turned(0), 0.3);
+  failed.joint->ok = false;
+  failed.joint->message = "the solver failed";
+  EXPECT_NE(judgeEstimate(failed, 10, s, std::nullopt, false).why.find("joint estimate failed"),
+            std::string::npos);
+}
+
+TEST(BroadcastGate, NoSilentRegressionUnlessMorePosesOrADifferentMount) {
+  const OnlineSettings s;
+  const BroadcastEstimate published = broadcastOf(jointResult(0.05, turned(0.0), 0.5), 10);
+  // Less precise, from no more poses, not significantly different: kept back ...
+  const GateOutcome worse =
+      judgeEstimate(jointResult(0.08, turned(0.1), 0.5), 10, s, published, false);
   EXPECT_EQ(worse.decision, GateDecision::kKeep);
   EXPECT_NE(worse.why.find("regression"), std::string::npos) << worse.why;
-  // ... unless the remount test restarted the window: then the old estimate is wrong.
-  EXPECT_EQ(judgeEstimate(goodResult(0.08, turned(10.0)), 3, s, published, true).decision,
+  // ... but more poses of the same mount never lose to fewer ...
+  EXPECT_EQ(judgeEstimate(jointResult(0.08, turned(0.1), 0.5), 11, s, published, false).decision,
+            GateDecision::kBroadcast);
+  // ... nor after a remount or reset (fresh start) ...
+  EXPECT_EQ(judgeEstimate(jointResult(0.08, turned(10.0), 0.5), 3, s, published, true).decision,
+            GateDecision::kBroadcast);
+  // ... nor when it differs from the broadcast one by far more than both 1-sigmas allow (2 deg
+  // against 0.05 and 0.08 deg: the mount moved while nothing watched).
+  EXPECT_EQ(judgeEstimate(jointResult(0.08, turned(2.0), 0.5), 5, s, published, false).decision,
             GateDecision::kBroadcast);
   // At least as precise and moved: broadcast.
-  EXPECT_EQ(judgeEstimate(goodResult(0.04, turned(0.2)), 10, s, published, false).decision,
+  EXPECT_EQ(judgeEstimate(jointResult(0.04, turned(0.2), 0.5), 10, s, published, false).decision,
             GateDecision::kBroadcast);
-  // A calibration loaded from a file has no known sigma: any good estimate replaces it.
-  const PublishedEstimate loaded{turned(0.0), std::numeric_limits<double>::infinity()};
+  // A calibration loaded from a file without a 1-sigma: any good estimate replaces it.
+  BroadcastEstimate loaded;
+  loaded.source = "loaded: x.yaml";
   EXPECT_EQ(judgeEstimate(goodResult(0.3, turned(0.2)), 3, s, loaded, false).decision,
             GateDecision::kBroadcast);
 }
 
+TEST(BroadcastGate, DifferenceSignificance) {
+  const BroadcastEstimate published = broadcastOf(jointResult(0.05, turned(0.0), 0.5), 10);
+  // 0.05 deg apart with 1-sigma 0.05 each: chi2 = 0.05^2 / (2 x 0.05^2) = 0.5 -> p ~ 0.92.
+  EXPECT_NEAR(differenceSignificance(jointResult(0.05, turned(0.05), 0.5), published), 0.919,
+              0.005);
+  EXPECT_LT(differenceSignificance(jointResult(0.05, turned(1.0), 0.5), published), 1e-10);
+  BroadcastEstimate unknown;
+  EXPECT_EQ(differenceSignificance(jointResult(0.05, turned(1.0), 0.5), unknown), 1.0);
+}
+
 TEST(BroadcastGate, ChangesBelowTheThresholdKeepTheTf) {
-  WrapperSettings s;
+  OnlineSettings s;
   s.min_change_deg = 0.05;
-  const PublishedEstimate published{turned(0.0), 0.05};
+  const BroadcastEstimate published = broadcastOf(goodResult(0.05, turned(0.0)), 10);
   EXPECT_EQ(judgeEstimate(goodResult(0.04, turned(0.03)), 10, s, published, false).decision,
             GateDecision::kKeep);
   EXPECT_EQ(judgeEstimate(goodResult(0.04, turned(0.08)), 10, s, published, false).decision,

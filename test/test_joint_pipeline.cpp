@@ -32,22 +32,8 @@ struct Outcome {
 
 /// The grade's priors for the joint estimate (a user sets them for the unit in
 /// config/default.yaml).
-JointSettings settingsFor(const sim::SimulationConfig& c) {
-  JointSettings s;
-  const auto& e = c.imu_systematic;
-  if (e.gyro_scale_sigma > 0.0) {
-    s.priors.gyro_scale = e.gyro_scale_sigma;
-    s.priors.gyro_cross_axis = e.gyro_cross_axis_sigma;
-    s.priors.accel_scale = e.accel_scale_sigma;
-    s.priors.accel_cross_axis = e.accel_cross_axis_sigma;
-    s.priors.hard_iron_t = std::max(1e-6, e.mag_hard_iron_sigma);
-    s.priors.soft_iron_scale = s.priors.soft_iron_cross = std::max(0.005, e.mag_soft_iron_sigma);
-  }
-  s.priors.accel_bias_m_s2 = std::max(0.01, 2.0 * c.imu_noise.accelerometer_initial_bias_sigma);
-  return s;
-}
+using test::jointSettingsFor;
 
-/// `gyro_noise_density` > 0 replaces the scenario's gyro white noise (rad/s/sqrt(Hz)).
 Outcome monteCarlo(const std::string& scenario, int seeds, double gyro_noise_density = 0.0,
                    ImuOrientationSource compare_with = ImuOrientationSource::kAuto) {
   Outcome out;
@@ -59,7 +45,7 @@ Outcome monteCarlo(const std::string& scenario, int seeds, double gyro_noise_den
     c.camera_rate_hz = 1.0;  // frames are given by the harness, not rendered
     const sim::SimulationRun run(c);
     PipelineSettings settings;
-    settings.joint = settingsFor(c);
+    settings.joint = jointSettingsFor(c);
     const auto pipeline = test::feedWithoutImages(run, settings, 0.03, false, 100 + c.seed);
     ++out.runs;
     const AlignmentResult r = pipeline->solve();

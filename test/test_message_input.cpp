@@ -1,7 +1,7 @@
-// The ROS boundary (src/ros/message_input.cpp, clock_jump.cpp): every kind of bad message the
-// nodelet and calibrate_bag can receive is refused, counted under its reason and reported with the
-// stream it came from; nothing non-finite gets through; frame ids are normalised; clock jumps are
-// told apart from a camera's latency.
+// The ROS boundary (src/ros/message_input.cpp; the clock-jump detector of src/core/pipeline): every
+// kind of bad message the nodelet and calibrate_bag can receive is refused, counted under its
+// reason and reported with the stream it came from; nothing non-finite gets through; frame ids are
+// normalised; clock jumps are told apart from a camera's latency.
 #include <gtest/gtest.h>
 
 #include <tf2/buffer_core.h>
@@ -13,7 +13,8 @@
 #include <thread>
 #include <vector>
 
-#include "camera_imu_alignment/ros/clock_jump.h"
+#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/pipeline/clock_jump.h"
 #include "camera_imu_alignment/ros/message_conversion.h"
 #include "camera_imu_alignment/ros/message_input.h"
 #include "camera_imu_alignment/solver/rotation_math.h"

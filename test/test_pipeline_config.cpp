@@ -8,6 +8,7 @@
 #include <set>
 
 #include "camera_imu_alignment/io/input_error.h"
+#include "camera_imu_alignment/pipeline/online_config.h"
 #include "camera_imu_alignment/pipeline/pipeline_config.h"
 #include "camera_imu_alignment/ros/wrapper_settings.h"
 #include "test_helpers.h"
@@ -119,29 +120,39 @@ void expectDefaults(const PipelineSettings& s) {
 
 TEST(PipelineConfig, DocumentedDefaultsEqualTheBuiltInOnes) {
   PipelineSettings loaded = scrambled();
-  ASSERT_NO_THROW(loadPipelineConfig(configPath(), &loaded, wrapperKeys()));
+  OnlineSettings online;
+  online.min_poses = 7, online.max_residual_deg = 7, online.max_std_dev_deg = 7;
+  online.consistency_level = 0.7, online.min_change_deg = 7;
+  online.remount.level = 0.7, online.remount.max_poses_after = 7;
+  online.remount_poses = 7, online.remount_residual_deg = 7, online.manual_capture = true;
+  ASSERT_NO_THROW(loadCalibrationConfig(configPath(), &loaded, &online, wrapperKeys()));
   expectDefaults(loaded);
+  const OnlineSettings online_defaults;
+  EXPECT_EQ(online.min_poses, online_defaults.min_poses);
+  EXPECT_EQ(online.max_residual_deg, online_defaults.max_residual_deg);
+  EXPECT_EQ(online.max_std_dev_deg, online_defaults.max_std_dev_deg);
+  EXPECT_EQ(online.consistency_level, online_defaults.consistency_level);
+  EXPECT_EQ(online.min_change_deg, online_defaults.min_change_deg);
+  EXPECT_EQ(online.remount.level, online_defaults.remount.level);
+  EXPECT_EQ(online.remount.max_poses_after, online_defaults.remount.max_poses_after);
+  EXPECT_EQ(online.remount.min_poses_after, online_defaults.remount.min_poses_after);
+  EXPECT_EQ(online.remount.min_poses_before, online_defaults.remount.min_poses_before);
+  EXPECT_EQ(online.remount_poses, online_defaults.remount_poses);
+  EXPECT_EQ(online.remount_residual_deg, online_defaults.remount_residual_deg);
+  EXPECT_EQ(online.manual_capture, online_defaults.manual_capture);
   // The wrapper's section too (target_file is required and has no default).
   std::ifstream in(configPath());
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   WrapperSettings w;
-  w.min_poses = 7, w.max_residual_deg = 7, w.max_std_dev_deg = 7, w.min_change_deg = 7;
-  w.remount_poses = 7, w.remount_residual_deg = 7, w.status_period_s = 7;
-  w.publish_inverse = true, w.load_on_start = false, w.manual_capture = true;
+  w.status_period_s = 7;
+  w.publish_inverse = true, w.load_on_start = false;
   PipelineSettings p;
   EXPECT_THROW(parseSettings(text, "default.yaml", &w, &p), InputError);  // target_file: ""
   ASSERT_NO_THROW(parseSettings(text + "target_file: t.yaml\n", "default.yaml", &w, &p));
   const WrapperSettings d;
-  EXPECT_EQ(w.min_poses, d.min_poses);
-  EXPECT_EQ(w.max_residual_deg, d.max_residual_deg);
-  EXPECT_EQ(w.max_std_dev_deg, d.max_std_dev_deg);
-  EXPECT_EQ(w.min_change_deg, d.min_change_deg);
-  EXPECT_EQ(w.remount_poses, d.remount_poses);
-  EXPECT_EQ(w.remount_residual_deg, d.remount_residual_deg);
   EXPECT_EQ(w.status_period_s, d.status_period_s);
   EXPECT_EQ(w.publish_inverse, d.publish_inverse);
   EXPECT_EQ(w.load_on_start, d.load_on_start);
-  EXPECT_EQ(w.manual_capture, d.manual_capture);
   EXPECT_EQ(w.camera_frame, d.camera_frame);
   EXPECT_EQ(w.output_file, d.output_file);
   EXPECT_EQ(w.image_transport, d.image_transport);
@@ -157,7 +168,9 @@ TEST(PipelineConfig, EveryKnownKeyIsDocumented) {
   }
   for (const auto& key : pipelineConfigKeys()) EXPECT_TRUE(documented.count(key)) << key;
   for (const auto& key : wrapperKeys()) EXPECT_TRUE(documented.count(key)) << key;
-  EXPECT_EQ(documented.size(), pipelineConfigKeys().size() + wrapperKeys().size());
+  for (const auto& key : onlineConfigKeys()) EXPECT_TRUE(documented.count(key)) << key;
+  EXPECT_EQ(documented.size(),
+            pipelineConfigKeys().size() + wrapperKeys().size() + onlineConfigKeys().size());
 }
 
 void expectRefused(const std::string& text, const std::string& expected_in_message) {
@@ -201,6 +214,10 @@ TEST(WrapperSettings, BadParametersAreRefusedNamingThem) {
   refused("min_poses: 1\n", "min_poses");
   refused("max_std_dev_deg: 0\n", "max_std_dev_deg");
   refused("remount_residual_deg: -2\n", "remount_residual_deg");
+  refused("consistency_level: 1.5\n", "consistency_level");
+  refused("remount_level: 0\n", "remount_level");
+  refused("remount_min_poses_after: 1\n", "remount_min_poses_after");
+  refused("remount_max_poses_after: 1\n", "remount_max_poses_after");
   refused("publish_inverse: maybe\n", "publish_inverse");
   refused("window_poses: 1\n", "window_poses");
   refused("camera_frme: cam\n", "unknown key 'camera_frme'");
@@ -219,9 +236,11 @@ std::string refusal(const std::string& text) {
 }
 
 TEST(Settings, EveryBadValueNamesTheKeyTheAllowedValuesAndTheValueGiven) {
-  // A value of the wrong kind for every key of both tables: one form, "key = value: must be ...".
+  // A value of the wrong kind for every key of the three tables: one form, "key = value: must be
+  // ...".
   std::vector<std::string> keys = pipelineConfigKeys();
   keys.insert(keys.end(), wrapperKeys().begin(), wrapperKeys().end());
+  keys.insert(keys.end(), onlineConfigKeys().begin(), onlineConfigKeys().end());
   for (const std::string& key : keys) {
     const std::string message = refusal(key + ": {a: 1}\n");
     EXPECT_NE(message.find("params: " + key + " = {a: 1}: must be "), std::string::npos) << message;
@@ -241,7 +260,9 @@ TEST(Settings, EveryBadValueNamesTheKeyTheAllowedValuesAndTheValueGiven) {
       {"solver_method: best", "solver_method = best: must be 'optimal' or 'two_step'"},
       {"mag_hard_iron_t: [1, 2]", "mag_hard_iron_t = [1, 2]: must be a list of 3 finite numbers"},
       {"two_step_max_iterations: 0", "two_step_max_iterations = 0: must be an integer >= 1"},
-      {"max_std_dev_deg: 0", "max_std_dev_deg = 0: must be a finite number > 0"}};
+      {"max_std_dev_deg: 0", "max_std_dev_deg = 0: must be a finite number > 0"},
+      {"consistency_level: 2", "consistency_level = 2: must be a number within (0, 1)"},
+      {"remount_min_poses_after: 1", "remount_min_poses_after = 1: must be an integer >= 2"}};
   for (const auto& [text, expected] : cases) {
     const std::string message = refusal(text + "\n");
     EXPECT_NE(message.find(expected), std::string::npos) << text << " -> " << message;

@@ -12,7 +12,7 @@
 // so that a unit whose noise the priors understate (chi2/dof > 1) does not read as a remount; the
 // p-value is Bonferroni-corrected for the number of candidates. A candidate counts only when the
 // two-mount model fits every pose: no pose's RMS whitened residual (JointResult::
-// pose_residual_norm) above max(2, 3 x the median pose's). A split next to the true one, or one
+// pose_residual_norm) above max(1.5, 2.5 x the median pose's). A split next to the true one, or one
 // pose that is merely bad, leaves a pose unfitted however large D is. A change is declared when
 // the corrected p-value of the counting candidate with the largest D is below `level`.
 #pragma once
@@ -46,7 +46,7 @@ struct MountChangeCandidate {
   double p_value = 1;        ///< of F, not corrected
   double change_deg = 0;     ///< angle between the two mounts' R_cam_imu
   bool solved = false;       ///< the two-mount solve succeeded
-  /// Worst pose residual over max(2, 3 x median) in the two-mount solve; <= 1: fits every pose.
+  /// Worst pose residual over max(1.5, 2.5 x median) in the two-mount solve; <= 1: fits every pose.
   double worst_pose_misfit = 0;
   bool fits_every_pose = false;
 };

@@ -15,14 +15,14 @@ namespace camera_imu_alignment {
 std::string MountChangeSettings::validate() const {
   std::ostringstream out;
   if (!(level > 0.0 && level < 1.0)) {
-    out << "remount_level = " << level << ": must be within (0, 1)";
+    out << "remount_level = " << level << ": must be a number within (0, 1)";
   } else if (min_poses_after < 2) {
-    out << "remount_min_poses_after = " << min_poses_after << ": must be >= 2";
+    out << "remount_min_poses_after = " << min_poses_after << ": must be an integer >= 2";
   } else if (max_poses_after < min_poses_after) {
     out << "remount_max_poses_after = " << max_poses_after
-        << ": must be >= remount_min_poses_after (" << min_poses_after << ")";
+        << ": must be an integer >= remount_min_poses_after (" << min_poses_after << ")";
   } else if (min_poses_before < 2) {
-    out << "remount_min_poses_before = " << min_poses_before << ": must be >= 2";
+    out << "remount_min_poses_before = " << min_poses_before << ": must be an integer >= 2";
   }
   return out.str();
 }
@@ -35,7 +35,7 @@ double fisherUpperTail(double f, int d1, int d2) {
 
 namespace {
 
-/// max_k norm_k / max(2, 3 x median norm): above 1, some pose is not fitted (in sigma units,
+/// max_k norm_k / max(1.5, 2.5 x median norm): above 1, some pose is not fitted (in sigma units,
 /// relative to the typical pose, so that a unit whose noise the priors understate is judged by
 /// its own scale).
 double worstPoseMisfit(std::vector<double> norms) {
@@ -43,7 +43,7 @@ double worstPoseMisfit(std::vector<double> norms) {
   const double worst = *std::max_element(norms.begin(), norms.end());
   std::nth_element(norms.begin(), norms.begin() + norms.size() / 2, norms.end());
   const double median = norms[norms.size() / 2];
-  return worst / std::max(2.0, 3.0 * median);
+  return worst / std::max(1.5, 2.5 * median);
 }
 
 }  // namespace

@@ -37,7 +37,7 @@ std::string OnlineSettings::validate() const {
   } else if (!positive(max_std_dev_deg)) {
     out << "max_std_dev_deg = " << max_std_dev_deg << ": must be a finite number > 0";
   } else if (!(consistency_level > 0.0 && consistency_level < 1.0)) {
-    out << "consistency_level = " << consistency_level << ": must be within (0, 1)";
+    out << "consistency_level = " << consistency_level << ": must be a number within (0, 1)";
   } else if (!positive(max_residual_deg)) {
     out << "max_residual_deg = " << max_residual_deg << ": must be a finite number > 0";
   } else if (!(std::isfinite(min_change_deg) && min_change_deg >= 0.0)) {

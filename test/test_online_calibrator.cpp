@@ -1,0 +1,250 @@
+// The online calibrator (pipeline/online_calibrator.h) without ROS, on simulated sample streams
+// (camera orientations given, no images) of several IMU grades: broadcasts within 0.2 deg of the
+// truth, finds a remount before anything was broadcast within 3 poses and then broadcasts the new
+// mount from the poses after it alone, raises no false remount on unchanged recordings; reset,
+// clock jumps, forced calibration, manual capture and the worker thread.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <vector>
+
+#include "camera_imu_alignment/pipeline/online_calibrator.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
+#include "pipeline_simulation.h"
+
+namespace camera_imu_alignment {
+namespace {
+
+namespace sim = simulation;
+
+sim::SimulationConfig configFor(sim::ImuGrade grade, std::uint64_t seed) {
+  sim::SimulationConfig c;
+  c.seed = seed;
+  EXPECT_TRUE(sim::applyScenario("nominal", &c));
+  sim::applyImuGrade(grade, &c);
+  return c;
+}
+
+/// Everything the calibrator said, in order.
+struct Recorder {
+  std::vector<StationaryPose> poses;
+  std::vector<EstimateEvent> estimates;
+  std::vector<BroadcastEstimate> broadcasts;
+  std::vector<RemountEvent> remounts;
+  std::vector<double> clock_jumps;
+  /// Poses found when each remount was reported (how many poses it took).
+  std::vector<int> poses_at_remount;
+  OnlineCallbacks callbacks() {
+    OnlineCallbacks cb;
+    cb.on_pose = [this](const StationaryPose& p) { poses.push_back(p); };
+    cb.on_estimate = [this](const EstimateEvent& e) { estimates.push_back(e); };
+    cb.on_broadcast = [this](const BroadcastEstimate& b) { broadcasts.push_back(b); };
+    cb.on_remount = [this](const RemountEvent& e) {
+      remounts.push_back(e);
+      poses_at_remount.push_back(static_cast<int>(poses.size()));
+    };
+    cb.on_clock_jump = [this](double jump_s, InputStream) { clock_jumps.push_back(jump_s); };
+    return cb;
+  }
+};
+
+struct Run {
+  std::unique_ptr<sim::SimulationRun> simulated;
+  Recorder recorder;
+  std::unique_ptr<OnlineCalibrator> calibrator;
+};
+
+std::unique_ptr<Run> calibrate(const sim::SimulationConfig& c, OnlineSettings online = {},
+                               bool finish = true) {
+  auto run = std::make_unique<Run>();
+  run->simulated = std::make_unique<sim::SimulationRun>(c);
+  PipelineSettings settings;
+  settings.joint = test::jointSettingsFor(c);
+  run->calibrator =
+      std::make_unique<OnlineCalibrator>(parseTargetYaml(sim::targetYaml(c.target), "target"),
+                                         settings, online, run->recorder.callbacks());
+  test::feedSinkWithoutImages(*run->simulated, run->calibrator.get(), 0.03, false, 50 + c.seed);
+  if (finish) {
+    run->calibrator->finish();
+    run->calibrator->waitForSolves();
+  }
+  return run;
+}
+
+OnlineSettings synchronous() {
+  OnlineSettings s;
+  s.threaded = false;
+  return s;
+}
+
+double errorDeg(const Eigen::Matrix3d& R, const Eigen::Matrix3d& truth) {
+  return rad2deg(geodesicDistance(R, truth));
+}
+
+TEST(OnlineCalibrator, BroadcastsWithinATenthOfADegreeForEachGrade) {
+  for (sim::ImuGrade grade :
+       {sim::ImuGrade::kIdeal, sim::ImuGrade::kTactical, sim::ImuGrade::kConsumer}) {
+    const auto run = calibrate(configFor(grade, 41), synchronous());
+    const OnlineCalibrator& c = *run->calibrator;
+    ASSERT_TRUE(c.broadcast().has_value()) << toString(grade) << ": " << c.stateMessage();
+    EXPECT_EQ(c.state(), CalibrationState::kCalibrated) << c.stateMessage();
+    EXPECT_LT(errorDeg(c.broadcast()->R_cam_imu, run->simulated->trajectory.R_cam_imu_final()), 0.2)
+        << toString(grade);
+    EXPECT_EQ(c.remounts(), 0) << toString(grade);
+    // What is broadcast carries its own quality: the poses and 1-sigma of that estimate.
+    const BroadcastEstimate& b = run->recorder.broadcasts.back();
+    ASSERT_TRUE(b.result.has_value());
+    EXPECT_EQ(b.source, "estimated");
+    EXPECT_GE(b.poses, 3);
+    EXPECT_LE(b.poses, static_cast<int>(run->recorder.poses.size()));
+    EXPECT_EQ(b.std_dev_deg, b.result->quality.std_dev_deg);
+  }
+}
+
+TEST(OnlineCalibrator, RemountBeforeTheFirstBroadcastIsFoundWithinThreePoses) {
+  // The mount turns after the sixth pose; min_poses is high enough that nothing is broadcast
+  // before it (the case: a residual gate then blocked every broadcast for ever).
+  // The noisy grade (MPU-6050 class on a vibrating mount) is held to less: its change is found
+  // within 3 poses, but a 2 deg turn is split one pose early and the new mount's 7 poses do not
+  // give 0.2 deg (its 12-pose accuracy is 0.37 deg RMS, BENCHMARKS.md).
+  int case_index = 0;
+  for (sim::ImuGrade grade :
+       {sim::ImuGrade::kTactical, sim::ImuGrade::kConsumer, sim::ImuGrade::kNoisy}) {
+    for (double turn_deg : {2.0, 5.0}) {
+      sim::SimulationConfig c = configFor(grade, 60 + case_index);
+      c.num_poses = 14;
+      c.remount = true;
+      c.remount_rotvec_cam = deg2rad(turn_deg) * Eigen::Vector3d(0.6, -0.8, 0.0);
+      OnlineSettings online = synchronous();
+      online.min_poses = 7;
+      const auto run = calibrate(c, online);
+      ++case_index;
+      const Recorder& r = run->recorder;
+      const double t_remount = run->simulated->trajectory.remountTime();
+      int first_after = -1;
+      for (const StationaryPose& p : r.poses) {
+        if (p.start_s > t_remount) {
+          first_after = p.index;
+          break;
+        }
+      }
+      ASSERT_GE(first_after, 1);
+      const std::string what =
+          std::string(toString(grade)) + " " + std::to_string(turn_deg) + " deg";
+      ASSERT_FALSE(r.remounts.empty()) << what << ": " << run->calibrator->stateMessage();
+      // Found when the 2nd or 3rd pose of the new mount arrived.
+      EXPECT_LE(r.poses_at_remount.front() - first_after, 3) << what;
+      if (grade == sim::ImuGrade::kNoisy) continue;
+      EXPECT_EQ(r.remounts.front().first_pose_index, first_after) << what;
+      EXPECT_NEAR(r.remounts.front().change_deg, turn_deg, 0.3) << what;
+      EXPECT_EQ(r.remounts.size(), 1u) << what << ": " << r.remounts.back().message;
+      // Then the new mount, from its own poses only, within 0.2 deg.
+      ASSERT_TRUE(run->calibrator->broadcast().has_value()) << what;
+      const BroadcastEstimate& b = *run->calibrator->broadcast();
+      EXPECT_LT(errorDeg(b.R_cam_imu, run->simulated->trajectory.R_cam_imu_final()), 0.2) << what;
+      EXPECT_LE(b.poses, static_cast<int>(r.poses.size()) - first_after) << what;
+    }
+  }
+}
+
+TEST(OnlineCalibrator, NoFalseRemountOnUnchangedRecordings) {
+  int remounts = 0;
+  for (sim::ImuGrade grade :
+       {sim::ImuGrade::kTactical, sim::ImuGrade::kConsumer, sim::ImuGrade::kNoisy}) {
+    for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+      const auto run = calibrate(configFor(grade, 80 + seed), synchronous());
+      remounts += run->calibrator->remounts();
+      EXPECT_EQ(run->calibrator->remounts(), 0)
+          << toString(grade) << " seed " << seed << ": " << run->calibrator->stateMessage();
+    }
+  }
+  std::printf("false remounts in 12 unchanged recordings: %d\n", remounts);
+}
+
+TEST(OnlineCalibrator, ResetForgetsTheWindowAndKeepsTheBroadcast) {
+  const auto run = calibrate(configFor(sim::ImuGrade::kConsumer, 43), synchronous());
+  OnlineCalibrator& c = *run->calibrator;
+  ASSERT_TRUE(c.broadcast().has_value());
+  const Eigen::Matrix3d broadcast = c.broadcast()->R_cam_imu;
+  c.reset();
+  EXPECT_EQ(c.pipeline().windowSize(), 0u);
+  EXPECT_EQ(c.pipeline().posesTotal(), 0u);
+  EXPECT_FALSE(c.lastEstimate().has_value());
+  EXPECT_EQ(c.state(), CalibrationState::kCollecting);
+  EXPECT_NE(c.stateMessage().find("reset"), std::string::npos);
+  ASSERT_TRUE(c.broadcast().has_value());
+  EXPECT_TRUE(c.broadcast()->R_cam_imu.isApprox(broadcast));
+  EXPECT_EQ(c.remounts(), 0);
+}
+
+TEST(OnlineCalibrator, AClockJumpBackClearsTheWindowAndKeepsTheBroadcast) {
+  const auto run = calibrate(configFor(sim::ImuGrade::kIdeal, 44), synchronous());
+  OnlineCalibrator& c = *run->calibrator;
+  ASSERT_TRUE(c.broadcast().has_value());
+  ASSERT_GT(c.pipeline().windowSize(), 0u);
+  c.addImu({1.0, Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 9.81)});  // a bag loop
+  ASSERT_EQ(run->recorder.clock_jumps.size(), 1u);
+  EXPECT_GT(run->recorder.clock_jumps[0], 10.0);
+  EXPECT_EQ(c.pipeline().windowSize(), 0u);
+  EXPECT_TRUE(c.broadcast().has_value());
+}
+
+TEST(OnlineCalibrator, CalibrateNowSaysWhyNotAndForceBroadcasts) {
+  OnlineSettings online = synchronous();
+  online.max_std_dev_deg = 1e-4;  // no estimate can pass
+  const auto run = calibrate(configFor(sim::ImuGrade::kIdeal, 45), online);
+  OnlineCalibrator& c = *run->calibrator;
+  EXPECT_FALSE(c.broadcast().has_value());
+  const CalibrateOutcome refused = c.calibrateNow(false);
+  EXPECT_EQ(refused.result.status, SolveStatus::kOk);
+  EXPECT_FALSE(refused.broadcast);
+  EXPECT_NE(refused.not_broadcast_reason.find("max_std_dev_deg"), std::string::npos)
+      << refused.not_broadcast_reason;
+  const CalibrateOutcome forced = c.calibrateNow(true);
+  EXPECT_TRUE(forced.broadcast);
+  ASSERT_TRUE(c.broadcast().has_value());
+  EXPECT_TRUE(c.broadcast()->R_cam_imu.isApprox(forced.result.R_cam_imu));
+  EXPECT_NE(c.stateMessage().find("force"), std::string::npos);
+}
+
+TEST(OnlineCalibrator, ManualCaptureWantsFramesOnlyWhileArmed) {
+  OnlineSettings online = synchronous();
+  online.manual_capture = true;
+  const auto run = calibrate(configFor(sim::ImuGrade::kIdeal, 46), online, false);
+  OnlineCalibrator& c = *run->calibrator;
+  EXPECT_FALSE(c.wantsFrames());
+  c.armCapture();
+  EXPECT_TRUE(c.wantsFrames());
+}
+
+TEST(OnlineCalibrator, TheWorkerThreadGivesTheSameFinalEstimate) {
+  const sim::SimulationConfig config = configFor(sim::ImuGrade::kConsumer, 47);
+  const auto inline_run = calibrate(config, synchronous());
+  OnlineSettings threaded;
+  threaded.threaded = true;
+  const auto threaded_run = calibrate(config, threaded);
+  ASSERT_TRUE(inline_run->calibrator->lastEstimate().has_value());
+  ASSERT_TRUE(threaded_run->calibrator->lastEstimate().has_value());
+  EXPECT_LT(errorDeg(inline_run->calibrator->lastEstimate()->result.R_cam_imu,
+                     threaded_run->calibrator->lastEstimate()->result.R_cam_imu),
+            1e-9);
+  EXPECT_TRUE(threaded_run->calibrator->broadcast().has_value());
+}
+
+TEST(OnlineCalibrator, SettingsValidatedByKey) {
+  OnlineSettings s;
+  s.consistency_level = 0.0;
+  const TargetDescription target = parseTargetYaml(
+      "target_type: checkerboard\ntargetCols: 8\ntargetRows: 6\nrowSpacingMeters: 0.04\n"
+      "colSpacingMeters: 0.04\n",
+      "target");
+  try {
+    OnlineCalibrator c(target, PipelineSettings{}, s, {});
+    ADD_FAILURE() << "accepted consistency_level 0";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("consistency_level"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace camera_imu_alignment
