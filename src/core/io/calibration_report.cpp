@@ -316,7 +316,11 @@ void drawEstimateText(cv::Mat& img, const cv::Rect& panel, const ReportInput& in
     y += 22;
   };
   line("status: " + std::string(toString(r.status)), statusColour(r.status));
-  if (in.verdict) line("verdict: " + in.verdict->text, in.verdict->passed ? kGreen : kRed);
+  if (in.verdict) {
+    for (const std::string& text : wrapText("verdict: " + in.verdict->text, width, 0.5, 2)) {
+      line(text, in.verdict->passed ? kGreen : kRed);
+    }
+  }
   for (const std::string& text : wrapText(r.message, width, 0.5, 2)) line(text, kBlack);
   line("q_cam_imu (x, y, z, w): [" + fixed(quat.x(), 6) + ", " + fixed(quat.y(), 6) + ", " +
            fixed(quat.z(), 6) + ", " + fixed(quat.w(), 6) + "]   (p_cam = R_cam_imu * p_imu, " +
@@ -327,8 +331,10 @@ void drawEstimateText(cv::Mat& img, const cv::Rect& panel, const ReportInput& in
   line("1-sigma about camera x, y, z (deg): " + fixedList(q.std_dev_deg, 4), kBlack);
   if (figures.truth_error) {
     const double worst = figures.truth_error->max_abs_error_over_sigma();
-    line(truthErrorText(*figures.truth_error),
-         std::isfinite(worst) && worst <= 3.0 ? kBlack : kRed);
+    const cv::Scalar colour = std::isfinite(worst) && worst <= 3.0 ? kBlack : kRed;
+    for (const std::string& text : wrapText(truthErrorText(*figures.truth_error), width, 0.5, 2)) {
+      line(text, colour);
+    }
   }
   std::string joint_text;
   cv::Scalar joint_colour;
