@@ -66,7 +66,7 @@ TEST(ReportFigures, TruthErrorIsTheAngleToTheTruthWithPerAxisErrorsInSigmas) {
   angle << std::fixed << std::setprecision(4) << test::angleBetweenDeg(R_est, R_cam_imu);
   EXPECT_NE(text.find("truth (rig.truth.yaml): error " + angle.str() + " deg"), std::string::npos)
       << text;
-  EXPECT_LE(e.max_abs_error_over_sigma(), 3.0);
+  EXPECT_LE(e.largestErrorInSigmas(), 3.0);
   EXPECT_EQ(text.find("beyond 3 sigma"), std::string::npos) << text;
 
   // A truth 1 deg away from the estimate is many sigmas off and said so.
@@ -74,7 +74,7 @@ TEST(ReportFigures, TruthErrorIsTheAngleToTheTruthWithPerAxisErrorsInSigmas) {
   const TruthError far = *reportFigures(in).truth_error;
   EXPECT_NEAR(far.angle_deg, 1.0, 1e-9);
   EXPECT_NEAR(far.error_deg.x(), -1.0, 1e-9);  // the estimate is -1 deg about camera x from it
-  EXPECT_GT(far.max_abs_error_over_sigma(), 3.0);
+  EXPECT_GT(far.largestErrorInSigmas(), 3.0);
   EXPECT_NE(formatSummary(in).find("(beyond 3 sigma)"), std::string::npos);
 }
 

@@ -46,7 +46,7 @@ struct TruthError {
   /// error_deg / sigma_deg per axis (NaN where the sigma is not a positive finite number).
   Eigen::Vector3d error_over_sigma = Eigen::Vector3d::Zero();
   /// Largest |error_over_sigma| (NaN when none is finite).
-  double max_abs_error_over_sigma() const;
+  double largestErrorInSigmas() const;
 };
 
 struct ReportFigures {

@@ -330,7 +330,7 @@ void drawEstimateText(cv::Mat& img, const cv::Rect& panel, const ReportInput& in
        kBlack);
   line("1-sigma about camera x, y, z (deg): " + fixedList(q.std_dev_deg, 4), kBlack);
   if (figures.truth_error) {
-    const double worst = figures.truth_error->max_abs_error_over_sigma();
+    const double worst = figures.truth_error->largestErrorInSigmas();
     const cv::Scalar colour = std::isfinite(worst) && worst <= 3.0 ? kBlack : kRed;
     for (const std::string& text : wrapText(truthErrorText(*figures.truth_error), width, 0.5, 2)) {
       line(text, colour);

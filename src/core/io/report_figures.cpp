@@ -81,7 +81,7 @@ std::map<int, Eigen::Matrix3d> targetInWorldByGroup(const ReportInput& in, std::
 
 }  // namespace
 
-double TruthError::max_abs_error_over_sigma() const {
+double TruthError::largestErrorInSigmas() const {
   double worst = kNaN;
   for (int a = 0; a < 3; ++a) {
     const double v = std::abs(error_over_sigma(a));
@@ -150,7 +150,7 @@ std::string jointConsistencyText(const JointResult& j) {
 }
 
 std::string truthErrorText(const TruthError& e) {
-  const double worst = e.max_abs_error_over_sigma();
+  const double worst = e.largestErrorInSigmas();
   return "truth" + (e.source.empty() ? std::string() : " (" + e.source + ")") + ": error " +
          fixed(e.angle_deg, 4) + " deg, about camera x, y, z " + fixedList(e.error_deg, 4) +
          " deg = " + fixedList(e.error_over_sigma, 2) + " x 1-sigma" +
