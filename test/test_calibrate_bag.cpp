@@ -5,7 +5,9 @@
 
 #include <Eigen/Geometry>
 #include <filesystem>
+#include <iomanip>
 #include <opencv2/imgcodecs.hpp>
+#include <sstream>
 
 #include "camera_imu_alignment/io/result_yaml.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
@@ -143,6 +145,31 @@ TEST(CalibrateBag, ExportedPosesGiveSolveRotationTheSameAnswer) {
   EXPECT_EQ(yaml["quality"]["num_pairs"].as<int>(), 15);
   EXPECT_LT(rad2deg(geodesicDistance(readResultYaml(solved).R_cam_imu, result.R_cam_imu)), 1e-6);
   EXPECT_LT(rad2deg(geodesicDistance(result.R_cam_imu, result.R_cam_imu_true)), 0.1);
+  removeBag(bag);
+}
+
+TEST(CalibrateBag, TruthAndPosesReachTheSummaryAndTheReport) {
+  // --truth: the summary's truth line and the tool's own "error to" line give the same angle;
+  // every pose of the window has its line; the page is written at its size.
+  const std::string bag = simulate("report", "--scenario nominal --seed 34 --num-poses 5");
+  const std::string truth = stem(bag) + ".truth.yaml", page = temp("report.png");
+  const Calibration result = calibrate(bag, "--truth " + truth + " --report " + page);
+  ASSERT_EQ(result.run.exit_code, 0) << result.run.err;
+  const std::string& out = result.run.out;
+  std::ostringstream angle;
+  angle << std::fixed << std::setprecision(4)
+        << rad2deg(geodesicDistance(result.R_cam_imu, result.R_cam_imu_true));
+  EXPECT_NE(out.find("truth (" + truth + "): error " + angle.str() + " deg"), std::string::npos)
+      << angle.str() << "\n"
+      << out;
+  EXPECT_NE(out.find("error to " + truth + ": " + angle.str() + " deg"), std::string::npos) << out;
+  for (int k = 0; k < 5; ++k) {
+    EXPECT_NE(out.find("  pose   " + std::to_string(k) + "  t "), std::string::npos) << out;
+  }
+  EXPECT_EQ(out.find("(not in the window)"), std::string::npos) << out;
+  const cv::Mat image = cv::imread(page);
+  EXPECT_EQ(image.cols, 1200);
+  EXPECT_EQ(image.rows, 1340);
   removeBag(bag);
 }
 

@@ -1,7 +1,9 @@
 // The calibration report: roll/pitch/yaw against analytic rotations, the export blocks parsed back
-// (Kalibr, OpenVINS, VINS, tf2) to 1e-8, the summary text, and the PNG page for realistic, empty
-// and NaN inputs.
+// (Kalibr, OpenVINS, VINS, tf2) to 1e-8, the summary text (the truth, verdict and per-pose lines
+// only added), and the PNG page for realistic, empty and NaN inputs. The figures per pose and to
+// the truth themselves: test_report_figures.cpp.
 #include "camera_imu_alignment/io/calibration_report.h"
+#include "camera_imu_alignment/io/report_figures.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 
 #include <gtest/gtest.h>
@@ -16,14 +18,18 @@
 #include <string>
 #include <vector>
 
-#include "camera_imu_alignment/solver/pose_window.h"
+#include "report_inputs.h"
 #include "test_helpers.h"
 
 namespace camera_imu_alignment {
 namespace {
 
 using test::axisAngle;
+using test::countColour;
+using test::countReddish;
+using test::degenerateInput;
 using test::randomRotation;
+using test::realisticInput;
 
 constexpr double kRoundTrip = 1e-8;  // exported numbers parsed back, absolute
 constexpr double kDeg = test::kPiTest / 180.0;
@@ -124,87 +130,6 @@ void expectMatrixNear(const Eigen::Matrix3d& actual, const Eigen::Matrix3d& expe
   EXPECT_LE((actual - expected).cwiseAbs().maxCoeff(), kRoundTrip) << what << "\nactual\n"
                                                                    << actual << "\nexpected\n"
                                                                    << expected;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Inputs
-// ---------------------------------------------------------------------------------------------
-
-/// A recording of `num_poses` rests 10 s apart: camera and IMU orientations consistent with
-/// R_cam_imu (plus small noise), all pairs formed from them and solved; one rest rejected.
-ReportInput realisticInput(std::mt19937_64& rng, const Eigen::Matrix3d& R_cam_imu, int num_poses,
-                           double noise_rad) {
-  ReportInput in;
-  in.start_s = 1000.0;
-  in.end_s = 1000.0 + 10.0 * (num_poses + 2);
-  in.source = "/data/rig.bag";
-  std::vector<PoseOrientation> orientations;
-  const Eigen::Matrix3d R_target_world = randomRotation(rng);  // unknown in practice; cancels
-  for (int k = 0; k < num_poses; ++k) {
-    const Eigen::Matrix3d R_world_imu = randomRotation(rng);
-    PoseOrientation o;
-    o.stamp_s = in.start_s + 5.0 + 10.0 * k;
-    o.R_world_imu = R_world_imu * test::rotationFromVector(test::gaussianVector(rng, noise_rad));
-    o.R_target_cam = R_target_world * R_world_imu * R_cam_imu.transpose() *
-                     test::rotationFromVector(test::gaussianVector(rng, noise_rad));
-    orientations.push_back(o);
-    StationaryPose pose;
-    pose.index = k;
-    pose.start_s = o.stamp_s - 2.0;
-    pose.end_s = o.stamp_s + 2.0;
-    pose.R_target_cam = o.R_target_cam;
-    pose.R_world_imu = o.R_world_imu;
-    in.poses.push_back(pose);
-    StationarySegment segment;
-    segment.start_s = pose.start_s - 0.5;
-    segment.end_s = pose.end_s + 0.5;
-    in.segments.push_back(segment);
-  }
-  RejectedPose rejected;
-  rejected.start_s = in.start_s + 5.0 + 10.0 * num_poses - 3.0;
-  rejected.end_s = rejected.start_s + 6.0;
-  rejected.reason = "target seen in 1 frame (2 needed)";
-  in.rejected.push_back(rejected);
-  in.segments.push_back({});
-  in.segments.back().start_s = rejected.start_s;
-  in.segments.back().end_s = rejected.end_s;
-  in.rejections.add(RejectReason::kTargetNotFound, 7);
-  in.rejections.add(RejectReason::kStampBackwards);
-  in.pairs = makeAllPairs(orientations);
-  in.result = solveAlignment(in.pairs);
-  return in;
-}
-
-/// Everything empty or NaN, start_s == end_s.
-ReportInput degenerateInput() {
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  ReportInput in;
-  in.start_s = in.end_s = 42.0;
-  SolutionQuality& q = in.result.quality;
-  q.residual_rms_deg = nan;
-  q.observability = nan;
-  q.weakest_excitation_deg = nan;
-  q.std_dev_deg = Eigen::Vector3d::Constant(nan);
-  q.weak_axis_cam = Eigen::Vector3d::Constant(nan);
-  q.excite_axis_cam = Eigen::Vector3d::Constant(nan);
-  q.covariance_rad2 = Eigen::Matrix3d::Constant(nan);
-  PairDiagnostics p;
-  p.residual_deg = nan;
-  q.pairs = {p, p};
-  q.num_pairs = 2;
-  in.pairs = {RotationPair{}, RotationPair{}};  // zero rotations: no axis
-  in.pairs[1].A_cam = Eigen::Matrix3d::Constant(nan);
-  in.segments.push_back({});
-  in.segments.back().start_s = nan;
-  in.segments.push_back({});
-  in.segments.back().start_s = -std::numeric_limits<double>::infinity();
-  in.segments.back().end_s = std::numeric_limits<double>::infinity();
-  in.rejected.push_back({nan, 42.0, ""});
-  StationaryPose reversed;
-  reversed.start_s = 50.0;
-  reversed.end_s = 10.0;
-  in.poses.push_back(reversed);
-  return in;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -320,15 +245,6 @@ TEST(FormatSummary, NanFieldsPrintNa) {
   EXPECT_NE(text.find("status: bad input"), std::string::npos) << text;
 }
 
-/// Count of pixels equal to `bgr`.
-int countColour(const cv::Mat& img, const cv::Vec3b& bgr) {
-  int n = 0;
-  for (int r = 0; r < img.rows; ++r) {
-    for (int c = 0; c < img.cols; ++c) n += img.at<cv::Vec3b>(r, c) == bgr;
-  }
-  return n;
-}
-
 TEST(RenderReport, RealisticInputDrawsAPageWithOutliersInRed) {
   std::mt19937_64 rng(15);
   const Eigen::Matrix3d R_cam_imu = randomRotation(rng);
@@ -343,18 +259,21 @@ TEST(RenderReport, RealisticInputDrawsAPageWithOutliersInRed) {
   ASSERT_FALSE(img.empty());
   EXPECT_EQ(img.type(), CV_8UC3);
   EXPECT_EQ(img.cols, 1200);
-  EXPECT_EQ(img.rows, 900);
+  EXPECT_EQ(img.rows, 1340);
   EXPECT_GT(countColour(img, {30, 30, 220}), 50);    // outlier bar, rejected rest
   EXPECT_GT(countColour(img, {40, 160, 40}), 200);   // accepted poses
   EXPECT_GT(countColour(img, {200, 110, 30}), 200);  // inlier bars, axis points
 }
 
 TEST(RenderReport, EmptyAndNanInputsDrawWithoutCrashing) {
-  for (const ReportInput& in : {ReportInput{}, degenerateInput()}) {
+  std::vector<ReportInput> inputs(1);
+  inputs.push_back(degenerateInput());
+  for (const ReportInput& in : inputs) {
     const cv::Mat img = renderReport(in);
     ASSERT_FALSE(img.empty());
     EXPECT_EQ(img.type(), CV_8UC3);
-    EXPECT_GT(img.total(), 0u);
+    EXPECT_EQ(img.cols, kReportWidthPx);
+    EXPECT_EQ(img.rows, kReportHeightPx);
   }
 }
 
@@ -391,6 +310,65 @@ TEST(WriteReportPng, WritesAReadablePngAndReportsUnwritablePaths) {
   error.clear();
   EXPECT_FALSE(writeReportPng(test::processTempDir() + "report.unknown_extension", in, &error));
   EXPECT_FALSE(error.empty());
+}
+
+/// The lines of `text`.
+std::vector<std::string> linesOf(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+TEST(FormatSummary, TruthVerdictAndPosesOnlyAddLines) {
+  std::mt19937_64 rng(26);
+  const Eigen::Matrix3d R_cam_imu = randomRotation(rng);
+  ReportInput plain = realisticInput(rng, R_cam_imu, 6, 0.002);
+  plain.poses.clear();  // the summary as it was: no per-pose lines
+  ReportInput full = realisticInput(rng, R_cam_imu, 6, 0.002);
+  full.result = plain.result;
+  full.pairs = plain.pairs;
+  full.truth = KnownTruth{R_cam_imu, "truth.yaml"};
+  full.verdict = ReportVerdict{false, "FAILED: remount at pose 6"};
+  const std::vector<std::string> before = linesOf(formatSummary(plain));
+  const std::vector<std::string> after = linesOf(formatSummary(full));
+  // Every line of the plain summary is in the full one, in the same order.
+  std::size_t j = 0;
+  for (const std::string& line : before) {
+    if (line.rfind("poses used:", 0) == 0) continue;  // counts differ (no poses in `plain`)
+    while (j < after.size() && after[j] != line) ++j;
+    ASSERT_LT(j, after.size()) << "missing or reordered: '" << line << "'";
+  }
+  const std::string text = formatSummary(full);
+  EXPECT_NE(text.find("\nverdict: FAILED: remount at pose 6\n"), std::string::npos) << text;
+  EXPECT_LT(text.find("status: ok"), text.find("verdict:"));
+  EXPECT_NE(text.find("\ntruth (truth.yaml): error "), std::string::npos) << text;
+  EXPECT_EQ(after.size(), before.size() + 2 + 2 + 6);  // verdict, truth, per-pose header, poses
+}
+
+TEST(RenderReport, VerdictAndTruthAreDrawnAndNanTruthPrintsNa) {
+  std::mt19937_64 rng(27);
+  const Eigen::Matrix3d R_cam_imu = randomRotation(rng);
+  ReportInput in = realisticInput(rng, R_cam_imu, 6, 0.002);
+  const cv::Mat plain = renderReport(in);
+  in.verdict = ReportVerdict{false, "FAILED: remount at pose 3"};
+  const cv::Mat failed = renderReport(in);
+  EXPECT_GT(countReddish(failed), countReddish(plain) + 50);
+  in.verdict.reset();
+  in.truth = KnownTruth{R_cam_imu, "truth.yaml"};
+  EXPECT_GT(cv::norm(renderReport(in), plain, cv::NORM_L1), 0.0);
+
+  ReportInput broken = degenerateInput();
+  broken.truth = KnownTruth{Eigen::Matrix3d::Constant(std::nan("")), "nan.yaml"};
+  const ReportFigures figures = reportFigures(broken);
+  ASSERT_TRUE(figures.truth_error);
+  EXPECT_TRUE(std::isnan(figures.truth_error->angle_deg));
+  const std::string text = formatSummary(broken);
+  EXPECT_NE(text.find("truth (nan.yaml): error n/a deg"), std::string::npos) << text;
+  EXPECT_EQ(text.find("nan "), std::string::npos) << text;
+  const cv::Mat img = renderReport(broken);
+  EXPECT_EQ(img.cols, kReportWidthPx);
+  EXPECT_EQ(img.rows, kReportHeightPx);
 }
 
 }  // namespace

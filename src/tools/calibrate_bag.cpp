@@ -66,8 +66,11 @@ const char* kUsage =
     "  --output RESULT.yaml  write the result YAML there (see doc/CONVENTIONS.md in the package)\n"
     "  --imu-yaml IMU.yaml   with the joint estimate: a Kalibr imu.yaml (noise densities measured\n"
     "                        at the rests) with the calibrated IMU intrinsics added\n"
-    "  --report REPORT.png   write a one-page report: residuals, axis coverage, rests, estimate\n"
-    "  --truth TRUTH.yaml    a YAML with R_cam_imu (e.g. simulate_bag's) to print the error to\n"
+    "  --report REPORT.png   write a one-page report: residuals per pair and per pose, axis\n"
+    "                        coverage, rests, reprojection per pose, estimate (and its error to\n"
+    "                        --truth)\n"
+    "  --truth TRUTH.yaml    a YAML with R_cam_imu (e.g. simulate_bag's) to print (and draw) the\n"
+    "                        error to\n"
     "  --export-poses POSES.csv  write the stationary poses the estimate used (the window) as the\n"
     "                        poses CSV that solve_rotation --poses reads (doc/CONVENTIONS.md)\n"
     "  --quiet               no progress on stderr\n"
@@ -376,6 +379,8 @@ int run(const cia::CliArgs& args) {
   report.imu_frame = cia::frameOr(info.imu_frame, cia::kDefaultImuFrame);
   report.source = bag_path;
   report.pairs = pipeline.windowPairs();
+  report.window_poses = pipeline.windowSize();
+  if (truth) report.truth = cia::KnownTruth{truth->R_cam_imu, args.get("--truth")};
   std::cout << cia::formatSummary(report);
   if (truth) {
     std::cout << std::fixed << std::setprecision(4) << "error to " << args.get("--truth") << ": "

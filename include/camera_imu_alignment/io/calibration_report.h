@@ -8,10 +8,16 @@
 
 namespace camera_imu_alignment {
 
-/// One-page report (CV_8UC3, about 1200x900): per-pair residuals (inliers / outliers), the
-/// coverage of rotation axes in the camera frame (which axes were excited), the stationary
-/// segments over time (poses used, rejected rests with reasons), and the estimate with its
-/// 1-sigma, observability and status.
+/// Size of the page (px).
+inline constexpr int kReportWidthPx = 1200, kReportHeightPx = 1340;
+
+/// One-page report (CV_8UC3, kReportWidthPx x kReportHeightPx): (a) per-pair residuals (inliers /
+/// outliers), (b) the coverage of rotation axes in the camera frame (which axes were excited),
+/// (c) the stationary segments over time (poses used, rejected rests with reasons), (d) per pose
+/// in recording order the mount it implies (a remount shows as a step), its pairs' residual, the
+/// joint estimate's residual and the reprojection error (report_figures.h), and (e) the estimate
+/// with its 1-sigma, the error to the truth when given, the joint estimate's consistency,
+/// observability, status and the verdict when given.
 cv::Mat renderReport(const ReportInput& input);
 
 /// renderReport + cv::imwrite; false with `error` set when writing fails.

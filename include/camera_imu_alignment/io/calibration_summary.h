@@ -3,6 +3,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,24 +14,44 @@
 
 namespace camera_imu_alignment {
 
+/// A known R_cam_imu to compare the estimate with (calibrate_bag --truth, e.g. simulate_bag's).
+struct KnownTruth {
+  Eigen::Matrix3d R_cam_imu = Eigen::Matrix3d::Identity();
+  std::string source;  ///< where it came from (the file), shown beside the error
+};
+
+/// A judgement of the run beyond the solver's status (quality gates, consistency, a remount),
+/// e.g. {false, "FAILED: remount at pose 6"}. Shown in the summary ("verdict: ...") and at the top
+/// of the report's estimate panel (red when !passed); set by the caller that made it.
+struct ReportVerdict {
+  bool passed = true;
+  std::string text;
+};
+
 struct ReportInput {
-  AlignmentResult result;                   ///< the final solve (status, R_cam_imu, quality)
-  RotationPairs pairs;                      ///< the pairs it was solved on (same order as
-                                            ///< result.quality.pairs)
-  std::vector<StationaryPose> poses;        ///< poses accepted
+  AlignmentResult result;             ///< the final solve (status, R_cam_imu, quality)
+  RotationPairs pairs;                ///< the pairs it was solved on (same order as
+                                      ///< result.quality.pairs)
+  std::vector<StationaryPose> poses;  ///< poses accepted, in recording order
+  /// The estimate used the newest `window_poses` of `poses` (the solver's window; the pairs' pose
+  /// indices count within it). 0: inferred from the pairs' pose indices and the joint estimate.
+  std::size_t window_poses = 0;
   std::vector<RejectedPose> rejected;       ///< rests that did not become poses, with reasons
   std::vector<StationarySegment> segments;  ///< every IMU rest
   RejectionCounts rejections;               ///< inputs rejected by reason
   double start_s = 0.0, end_s = 0.0;        ///< recording span (s), for the time axis
   std::string camera_frame = kDefaultCameraFrame;
   std::string imu_frame = kDefaultImuFrame;
-  std::string source;  ///< e.g. the bag path, shown in the title
+  std::string source;                    ///< e.g. the bag path, shown in the title
+  std::optional<KnownTruth> truth;       ///< when given: the error to it is shown
+  std::optional<ReportVerdict> verdict;  ///< when given: shown above the estimate
 };
 
 /// The stdout summary: R_cam_imu as quaternion (xyzw), matrix and roll/pitch/yaw (deg, the
 /// x-y-z fixed-axis convention of tf: R = Rz(yaw) Ry(pitch) Rx(roll)), 1-sigma about the camera
 /// axes, RMS residual, observability (and the axis to rotate about when not observable), poses
-/// used / rejected with reasons, inputs rejected by reason, then exportBlocks().
+/// used / rejected with reasons, inputs rejected by reason, the figures per pose and the error to
+/// the truth when given (report_figures.h), then exportBlocks().
 std::string formatSummary(const ReportInput& input);
 
 /// Ready-to-paste blocks, each introduced by a comment line naming the tool and the convention:

@@ -10,79 +10,34 @@
 #include <sstream>
 #include <vector>
 
+#include "camera_imu_alignment/io/joint_yaml.h"
+#include "camera_imu_alignment/io/report_figures.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
+#include "report_draw.h"
 #include "report_text.h"
 
 namespace camera_imu_alignment {
 namespace {
 
+using report_draw::drawPosePanel;
+using report_draw::kBlack;
+using report_draw::kBlue;
+using report_draw::kFont;
+using report_draw::kGreen;
+using report_draw::kGrey;
+using report_draw::kLightGrey;
+using report_draw::kOrange;
+using report_draw::kRed;
+using report_draw::niceCeil;
+using report_draw::panelFrame;
+using report_draw::putText;
+using report_draw::textWidth;
+using report_draw::wrapText;
 using report_text::canonicalQuaternion;
 using report_text::exact;
 using report_text::fixed;
 using report_text::fixedList;
 using report_text::hasAxisAdvice;
-
-// --- Drawing helpers (BGR colours, pixel coordinates)
-
-const cv::Scalar kBlack(0, 0, 0), kGrey(150, 150, 150), kLightGrey(225, 225, 225);
-const cv::Scalar kBlue(200, 110, 30), kGreen(40, 160, 40), kRed(30, 30, 220), kOrange(0, 140, 255);
-constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
-
-int textWidth(const std::string& text, double scale) {
-  int baseline = 0;
-  return cv::getTextSize(text, kFont, scale, 1, &baseline).width;
-}
-
-/// `text` shortened with "..." so that it fits in `max_width` px.
-std::string fitText(std::string text, int max_width, double scale) {
-  if (textWidth(text, scale) <= max_width) return text;
-  while (!text.empty() && textWidth(text + "...", scale) > max_width) text.pop_back();
-  return text + "...";
-}
-
-/// `text` broken at spaces into at most `max_lines` lines of at most `max_width` px (the last one
-/// shortened with "...").
-std::vector<std::string> wrapText(const std::string& text, int max_width, double scale,
-                                  int max_lines) {
-  std::vector<std::string> lines;
-  std::istringstream words(text);
-  std::string word, current;
-  while (words >> word) {
-    const std::string candidate = current.empty() ? word : current + " " + word;
-    if (current.empty() || textWidth(candidate, scale) <= max_width) {
-      current = candidate;
-      continue;
-    }
-    lines.push_back(current);
-    current = word;
-  }
-  if (!current.empty()) lines.push_back(current);
-  if (static_cast<int>(lines.size()) > max_lines) {
-    lines.resize(max_lines);
-    lines.back() += " ...";
-  }
-  for (std::string& line : lines) line = fitText(line, max_width, scale);
-  return lines;
-}
-
-void putText(cv::Mat& img, const std::string& text, cv::Point origin, double scale,
-             const cv::Scalar& colour, int max_width = 10000) {
-  cv::putText(img, fitText(text, max_width, scale), origin, kFont, scale, colour, 1, cv::LINE_AA);
-}
-
-void panelFrame(cv::Mat& img, const cv::Rect& panel, const std::string& title) {
-  cv::rectangle(img, panel, kGrey, 1);
-  putText(img, title, panel.tl() + cv::Point(8, 20), 0.55, kBlack, panel.width - 16);
-}
-
-/// Smallest 1, 2 or 5 times a power of ten >= value (value > 0).
-double niceCeil(double value) {
-  const double p = std::pow(10.0, std::floor(std::log10(value)));
-  for (double m : {1.0, 2.0, 5.0, 10.0}) {
-    if (m * p >= value * (1.0 - 1e-12)) return m * p;
-  }
-  return 10.0 * p;
-}
 
 // --- (a) Residual bars
 
@@ -295,7 +250,7 @@ void drawInterval(cv::Mat& img, const TimeAxis& axis, double a, double b, int y,
   }
 }
 
-/// Short tag of rejected rest i in the timeline ("r1", ...), listed with its reason in panel (d).
+/// Short tag of rejected rest i in the timeline ("r1", ...), listed with its reason in panel (e).
 std::string rejectedTag(std::size_t i) { return "r" + std::to_string(i + 1); }
 
 void drawTimeline(cv::Mat& img, const cv::Rect& panel, const ReportInput& in) {
@@ -327,15 +282,30 @@ void drawTimeline(cv::Mat& img, const cv::Rect& panel, const ReportInput& in) {
   drawTimeTicks(img, axis);
 }
 
-// --- (d) Estimate and quality as text
+// --- (e) Estimate and quality as text ((d), per pose: report_pose_panel.cpp)
 
 cv::Scalar statusColour(SolveStatus status) {
   if (status == SolveStatus::kOk) return kGreen;
   return status == SolveStatus::kNotObservable ? kOrange : kRed;
 }
 
-void drawEstimateText(cv::Mat& img, const cv::Rect& panel, const ReportInput& in) {
-  panelFrame(img, panel, "(d) estimate");
+/// The joint estimate's consistency, or why there is none.
+void jointLine(const AlignmentResult& r, std::string* text, cv::Scalar* colour) {
+  if (!r.joint) {
+    *text = "joint estimate: not run (estimate from the pairs alone)";
+    *colour = kBlack;
+  } else if (!r.joint->ok) {
+    *text = "joint estimate: FAILED (" + r.joint->message + "); the pair estimate is shown";
+    *colour = kRed;
+  } else {
+    *text = "joint estimate: " + jointConsistencyText(*r.joint);
+    *colour = r.joint->chi2_p_value >= kConsistencyLevel ? kGreen : kRed;
+  }
+}
+
+void drawEstimateText(cv::Mat& img, const cv::Rect& panel, const ReportInput& in,
+                      const ReportFigures& figures) {
+  panelFrame(img, panel, "(e) estimate");
   const AlignmentResult& r = in.result;
   const SolutionQuality& q = r.quality;
   const Eigen::Quaterniond quat = canonicalQuaternion(r.R_cam_imu);
@@ -346,6 +316,11 @@ void drawEstimateText(cv::Mat& img, const cv::Rect& panel, const ReportInput& in
     y += 22;
   };
   line("status: " + std::string(toString(r.status)), statusColour(r.status));
+  if (in.verdict) {
+    for (const std::string& text : wrapText("verdict: " + in.verdict->text, width, 0.5, 2)) {
+      line(text, in.verdict->passed ? kGreen : kRed);
+    }
+  }
   for (const std::string& text : wrapText(r.message, width, 0.5, 2)) line(text, kBlack);
   line("q_cam_imu (x, y, z, w): [" + fixed(quat.x(), 6) + ", " + fixed(quat.y(), 6) + ", " +
            fixed(quat.z(), 6) + ", " + fixed(quat.w(), 6) + "]   (p_cam = R_cam_imu * p_imu, " +
@@ -354,6 +329,17 @@ void drawEstimateText(cv::Mat& img, const cv::Rect& panel, const ReportInput& in
   line("roll, pitch, yaw (deg, R = Rz Ry Rx): " + fixedList(rollPitchYawDeg(r.R_cam_imu), 3),
        kBlack);
   line("1-sigma about camera x, y, z (deg): " + fixedList(q.std_dev_deg, 4), kBlack);
+  if (figures.truth_error) {
+    const double worst = figures.truth_error->largestErrorInSigmas();
+    const cv::Scalar colour = std::isfinite(worst) && worst <= 3.0 ? kBlack : kRed;
+    for (const std::string& text : wrapText(truthErrorText(*figures.truth_error), width, 0.5, 2)) {
+      line(text, colour);
+    }
+  }
+  std::string joint_text;
+  cv::Scalar joint_colour;
+  jointLine(r, &joint_text, &joint_colour);
+  line(joint_text, joint_colour);
   line("residual RMS: " + fixed(q.residual_rms_deg, 4) + " deg   inliers: " +
            std::to_string(q.num_inliers) + " / " + std::to_string(q.num_pairs) + " pairs",
        kBlack);
@@ -379,15 +365,16 @@ void drawEstimateText(cv::Mat& img, const cv::Rect& panel, const ReportInput& in
 }  // namespace
 
 cv::Mat renderReport(const ReportInput& input) {
-  constexpr int kWidth = 1200, kHeight = 900;
-  cv::Mat img(kHeight, kWidth, CV_8UC3, cv::Scalar(255, 255, 255));
+  const ReportFigures figures = reportFigures(input);
+  cv::Mat img(kReportHeightPx, kReportWidthPx, CV_8UC3, cv::Scalar(255, 255, 255));
   const std::string title =
       "camera-IMU rotation report" + (input.source.empty() ? std::string() : ": " + input.source);
-  putText(img, title, {10, 26}, 0.7, kBlack, kWidth - 20);
-  drawResiduals(img, cv::Rect(5, 40, 590, 400), input.result.quality);
-  drawAxisCoverage(img, cv::Rect(605, 40, 590, 400), input);
-  drawTimeline(img, cv::Rect(5, 448, 1190, 170), input);
-  drawEstimateText(img, cv::Rect(5, 626, 1190, 269), input);
+  putText(img, title, {10, 26}, 0.7, kBlack, kReportWidthPx - 20);
+  drawResiduals(img, cv::Rect(5, 40, 590, 370), input.result.quality);
+  drawAxisCoverage(img, cv::Rect(605, 40, 590, 370), input);
+  drawTimeline(img, cv::Rect(5, 418, 1190, 160), input);
+  drawPosePanel(img, cv::Rect(5, 586, 1190, 400), figures);
+  drawEstimateText(img, cv::Rect(5, 994, 1190, 341), input, figures);
   return img;
 }
 

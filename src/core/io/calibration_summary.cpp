@@ -5,9 +5,11 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 
 #include "camera_imu_alignment/io/joint_yaml.h"
+#include "camera_imu_alignment/io/report_figures.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "report_text.h"
 
@@ -94,11 +96,7 @@ void writeJoint(std::ostream& out, const JointResult& j) {
     out << "joint estimate: FAILED (" << j.message << "); the pair solve is reported\n";
     return;
   }
-  const double per_dof = j.dof > 0 ? j.chi2 / j.dof : 0.0;
-  out << "joint estimate: chi2/dof " << fixed(per_dof, 2) << " (" << j.dof << " dof, p "
-      << fixed(j.chi2_p_value, 3) << ": "
-      << (j.chi2_p_value >= kConsistencyLevel ? "consistent" : "INCONSISTENT") << ")"
-      << ", " << j.iterations << " iteration(s)\n";
+  out << "joint estimate: " << jointConsistencyText(j) << ", " << j.iterations << " iteration(s)\n";
   const ImuIntrinsics& i = j.intrinsics;
   const auto state = [](bool estimated) { return estimated ? "estimated" : "held at prior"; };
   const bool gyro_any = i.gyro_matrix_column_estimated[0] || i.gyro_matrix_column_estimated[1] ||
@@ -147,6 +145,26 @@ void writePoses(std::ostream& out, const ReportInput& in) {
   out << "inputs rejected: " << in.rejections.summary() << "\n";
 }
 
+/// One line per pose: what the report's per-pose panel draws.
+void writePoseFigures(std::ostream& out, const ReportFigures& figures) {
+  if (figures.poses.empty()) return;
+  out << "per pose (t: s from start, middle of the rest; reprojection: px; pairs: RMS residual of "
+         "its pairs at the estimate, deg;\n"
+         "  mount: the rotation from the estimate this pose implies about camera x, y, z, deg; "
+         "joint: whitened residual, sigma):\n";
+  for (const PoseFigure& f : figures.poses) {
+    std::ostringstream line;
+    line << "  pose " << std::setw(3) << f.index << "  t " << std::setw(8) << fixed(f.time_s, 1)
+         << "  frames " << std::setw(3) << f.num_frames << "  reprojection "
+         << fixed(f.reprojection_rms_px, 3) << "  pairs " << fixed(f.pair_residual_rms_deg, 3)
+         << "  mount " << fixedList(f.mount_offset_deg, 3) << "  joint "
+         << fixed(f.joint_residual_sigma, 2);
+    if (f.group != 0) line << "  group " << f.group;
+    if (!f.in_window) line << "  (not in the window)";
+    out << line.str() << "\n";
+  }
+}
+
 }  // namespace
 
 std::string exportBlocks(const Eigen::Matrix3d& R_cam_imu, const std::string& camera_frame,
@@ -160,10 +178,14 @@ std::string formatSummary(const ReportInput& input) {
   out << "=== camera-IMU rotation"
       << (input.source.empty() ? std::string() : " (" + input.source + ")") << " ===\n";
   out << "status: " << toString(input.result.status) << "\n";
+  if (input.verdict) out << "verdict: " << input.verdict->text << "\n";
   if (!input.result.message.empty()) out << "message: " << input.result.message << "\n";
+  const ReportFigures figures = reportFigures(input);
   writeEstimate(out, input);
   writeQuality(out, input);
+  if (figures.truth_error) out << truthErrorText(*figures.truth_error) << "\n";
   writePoses(out, input);
+  writePoseFigures(out, figures);
   out << "\n";
   if (input.result.status != SolveStatus::kOk) {
     out << "# WARNING: status '" << toString(input.result.status)
