@@ -381,30 +381,28 @@ int run(const cia::CliArgs& args) {
   report.pairs = pipeline.windowPairs();
   report.window_poses = pipeline.windowSize();
   if (truth) report.truth = cia::KnownTruth{truth->R_cam_imu, args.get("--truth")};
+  // The nodelet's verdict: a remount during the recording, a failed quality gate.
+  const bool gates_passed = outcome.gate.decision != cia::GateDecision::kReject && remounts.empty();
+  if (report.result.status == cia::SolveStatus::kOk) {
+    std::string text = "PASSED (the nodelet would broadcast it)";
+    if (!remounts.empty()) {
+      text = "FAILED: the mount changed during the recording (first before pose " +
+             std::to_string(remounts.front().first_pose_index) +
+             "); the estimate is of the last mount, from the poses after the change";
+      if (outcome.gate.decision == cia::GateDecision::kReject) text += "; and " + outcome.gate.why;
+    } else if (!gates_passed) {
+      text = "FAILED: " + outcome.gate.why;
+    }
+    report.verdict = cia::ReportVerdict{gates_passed, text};
+  }
   std::cout << cia::formatSummary(report);
   if (truth) {
     std::cout << std::fixed << std::setprecision(4) << "error to " << args.get("--truth") << ": "
               << cia::rad2deg(cia::geodesicDistance(report.result.R_cam_imu, truth->R_cam_imu))
               << " deg\n";
   }
-  // The nodelet's verdict: a remount during the recording, a failed quality gate.
   for (const cia::RemountEvent& e : remounts) {
     std::cout << "remount: " << e.message << "\n";
-  }
-  const bool gates_passed = outcome.gate.decision != cia::GateDecision::kReject && remounts.empty();
-  if (report.result.status == cia::SolveStatus::kOk) {
-    std::cout << "verdict: "
-              << (gates_passed ? std::string("PASSED (the nodelet would broadcast it)")
-                  : remounts.empty()
-                      ? "FAILED: " + outcome.gate.why
-                      : "FAILED: the mount changed during the recording (first at pose " +
-                            std::to_string(remounts.front().first_pose_index) +
-                            "); the estimate is of the last mount, from the poses after the "
-                            "change" +
-                            (outcome.gate.decision != cia::GateDecision::kReject
-                                 ? std::string()
-                                 : "; and " + outcome.gate.why))
-              << "\n";
   }
   if (args.has("--report")) {
     std::string error;
