@@ -140,6 +140,7 @@ std::map<std::string, std::string> waitForDiagnostics(
           last.clear();
           for (const auto& kv : status.values) last[kv.key] = kv.value;
           last["summary"] = status.message;
+          last["level"] = std::to_string(static_cast<int>(status.level));
         }
       });
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
@@ -280,6 +281,13 @@ TEST_F(AlignmentRos, ReplayBroadcastsTheTruthAndTheServicesWork) {
   Calibrate calibrate;
   ASSERT_TRUE(call("calibrate", &calibrate));
   EXPECT_TRUE(calibrate.response.success) << calibrate.response.message;
+  // Whether it is what the tf says, and why not when it is not.
+  EXPECT_EQ(calibrate.response.not_broadcast_reason.empty(), calibrate.response.broadcast)
+      << calibrate.response.not_broadcast_reason;
+  Calibrate forced;
+  forced.request.force = true;
+  ASSERT_TRUE(call("calibrate", &forced));
+  EXPECT_TRUE(forced.response.broadcast) << forced.response.not_broadcast_reason;
   EXPECT_TRUE(calibrate.response.observable);
   EXPECT_LT(angleDeg(toMatrix(calibrate.response.q_cam_imu), R_true), 0.2);
   EXPECT_GT(calibrate.response.std_dev_deg[0], 0.0);
@@ -298,6 +306,12 @@ TEST_F(AlignmentRos, ReplayBroadcastsTheTruthAndTheServicesWork) {
   std::string output;
   ASSERT_TRUE(ros::param::get(kNode + "/output_file", output));
   EXPECT_LT(angleDeg(readResultYaml(output).R_cam_imu, R_true), 0.2);
+  // What is saved is the broadcast estimate with its own quality: its poses, not the window's.
+  const auto broadcast_status =
+      waitForStatus(10.0, [](const AlignmentStatus& s) { return s.has_broadcast; });
+  ASSERT_TRUE(broadcast_status);
+  EXPECT_EQ(readResultYaml(output).num_poses, static_cast<int>(broadcast_status->broadcast_poses));
+  EXPECT_EQ(broadcast_status->broadcast_source, "estimated");
   const std::string saved = temp("saved.yaml");
   std::filesystem::copy_file(output, saved, std::filesystem::copy_options::overwrite_existing);
 
@@ -309,6 +323,19 @@ TEST_F(AlignmentRos, ReplayBroadcastsTheTruthAndTheServicesWork) {
   std_srvs::Trigger reset;
   ASSERT_TRUE(call("reset", &reset));
   EXPECT_TRUE(reset.response.success);
+  // ~reset resets: the window and the counts are empty, the broadcast calibration stays.
+  const auto after = waitForStatus(10.0, [](const AlignmentStatus& s) {
+    return s.poses_in_window == 0u && s.poses_total == 0u && !s.has_estimate;
+  });
+  ASSERT_TRUE(after);
+  EXPECT_EQ(after->poses_in_window, 0u);
+  EXPECT_FALSE(after->has_estimate);
+  EXPECT_TRUE(after->has_broadcast);
+  // ~save after the reset still writes the broadcast estimate with its own pose count.
+  std_srvs::Trigger save_after_reset;
+  ASSERT_TRUE(call("save", &save_after_reset));
+  EXPECT_TRUE(save_after_reset.response.success) << save_after_reset.response.message;
+  EXPECT_EQ(readResultYaml(output).num_poses, static_cast<int>(broadcast_status->broadcast_poses));
   Calibrate after_reset;
   ASSERT_TRUE(call("calibrate", &after_reset));
   EXPECT_FALSE(after_reset.response.success);
@@ -322,6 +349,42 @@ TEST_F(AlignmentRos, ReplayBroadcastsTheTruthAndTheServicesWork) {
   const auto restored = waitForTf(buffer_, "restored_cam", "restored_imu", 30.0);
   ASSERT_TRUE(restored) << restarted.log();
   EXPECT_LT(angleDeg(*restored, R_true), 0.2);
+  // Its status shows the loaded rotation and where it came from.
+  const auto loaded = waitForStatus(
+      15.0, [](const AlignmentStatus& s) { return s.has_broadcast; }, "/restarted");
+  ASSERT_TRUE(loaded) << restarted.log();
+  EXPECT_EQ(loaded->state, AlignmentStatus::CALIBRATED) << loaded->message;
+  EXPECT_EQ(loaded->broadcast_source, "loaded: " + saved);
+  EXPECT_LT(angleDeg(toMatrix(loaded->q_broadcast), R_true), 0.2);
+  EXPECT_GT(loaded->broadcast_poses, 0u);
+}
+
+TEST_F(AlignmentRos, AConsumerUnitsRemountBeforeTheFirstBroadcastIsFollowed) {
+  // A consumer-grade IMU (scale, cross-axis, biases, iron) whose mount turns by 3 deg after its
+  // fifth pose (30.2 s: between the holds of poses 4 and 5 for this seed); min_poses 6 keeps
+  // anything from being broadcast before the turn. The change is found although nothing was
+  // broadcast, and the new mount is broadcast within 0.2 deg from its 11 poses.
+  const std::string bag = simulate("consumer_remount",
+                                   "--scenario consumer --seed 61 --num-poses 16 --remount "
+                                   "--remount-deg 0,3,0 --remount-time-s 30.2");
+  const Eigen::Matrix3d R_after =
+      readResultYaml(bag.substr(0, bag.size() - 4) + ".truth.yaml").R_cam_imu;
+  const ExtraNode consumer("consumer",
+                           "_min_poses:=6 _load_on_start:=false _camera_frame:=consumer_cam "
+                           "_imu_frame:=consumer_imu" +
+                               remapsUnder("consumer"));
+  ASSERT_TRUE(consumer.started()) << consumer.log();
+  auto player = play(bag, 3.0, remapsUnder("consumer"));
+  const auto R = waitForTf(buffer_, "consumer_cam", "consumer_imu", 240.0,
+                           [&](const Eigen::Matrix3d& r) { return angleDeg(r, R_after) < 0.2; });
+  EXPECT_EQ(player.get(), 0);
+  ASSERT_TRUE(R) << consumer.log();
+  EXPECT_LT(angleDeg(*R, R_after), 0.2);
+  const auto status = waitForStatus(
+      10.0, [](const AlignmentStatus& s) { return s.remounts >= 1u; }, "/consumer");
+  ASSERT_TRUE(status) << consumer.log();
+  EXPECT_GE(status->remounts, 1u) << consumer.log();
+  EXPECT_NE(consumer.log().find("mount changed before pose"), std::string::npos);
 }
 
 TEST_F(AlignmentRos, RemountReconvergesToTheNewMounting) {
@@ -351,6 +414,10 @@ TEST_F(AlignmentRos, ManualCaptureTakesOnlyTheArmedRest) {
   std_srvs::Trigger capture;
   ASSERT_TRUE(ros::service::call("/manual/capture_pose", capture));
   EXPECT_TRUE(capture.response.success) << capture.response.message;
+  // Beside it, an instance listening to the same camera but to a wrong IMU topic.
+  const ExtraNode deaf(
+      "deaf", "_load_on_start:=false" + remapsUnder("manual") + " imu/data_raw:=/deaf/wrong_imu");
+  ASSERT_TRUE(deaf.started()) << deaf.log();
   EXPECT_EQ(play(bag, 3.0, remapsUnder("manual")).get(), 0);
   // All rests but the last are judged while the bag plays (the last one, unarmed, would not count
   // either); the status is latched.
@@ -358,6 +425,13 @@ TEST_F(AlignmentRos, ManualCaptureTakesOnlyTheArmedRest) {
       15.0, [](const AlignmentStatus& s) { return s.poses_total >= 1; }, "/manual");
   ASSERT_TRUE(last) << manual.log();
   EXPECT_EQ(last->poses_total, 1u) << manual.log();
+  // A wrong IMU topic: said, naming the topic, while the camera flows; diagnostics WARN.
+  const auto deaf_diagnostics = waitForDiagnostics("deaf", 20.0, [](const auto& v) {
+    return v.count("summary") && v.at("summary").find("nothing on") != std::string::npos;
+  });
+  EXPECT_NE(deaf.log().find("nothing on /deaf/wrong_imu"), std::string::npos) << deaf.log();
+  ASSERT_TRUE(deaf_diagnostics.count("level"));
+  EXPECT_EQ(deaf_diagnostics.at("level"), "1") << deaf_diagnostics.at("summary");  // WARN
   // The later rests were not armed: said so, not "no camera data".
   EXPECT_NE(manual.log().find("not used: not armed"), std::string::npos) << manual.log();
   EXPECT_EQ(manual.log().find("no camera data"), std::string::npos) << manual.log();
