@@ -193,6 +193,38 @@ TEST(CalibrateBag, SingleAxisMotionExitsThreeNamingTheAxisToRotateAbout) {
   removeBag(bag);
 }
 
+TEST(CalibrateBag, AMountThatMovedHalfwayExitsFourNamingThePose) {
+  // The case: 10 deg about camera y halfway (scenario remount); before the calibrator it
+  // said "status: ok", exit 0, 5.3 deg off. Now: the pose where the mount changed (the first rest
+  // after the remount time), exit 4, verdict FAILED in the summary and nothing written; the
+  // estimate printed is the new mount's.
+  const std::string bag = simulate("remount", "--scenario remount --seed 43");
+  const Calibration result = calibrate(bag, "--truth " + stem(bag) + ".truth.yaml");
+  EXPECT_EQ(result.run.exit_code, 4) << result.run.err << result.run.out;
+  EXPECT_NE(result.run.out.find("verdict: FAILED: the mount changed during the recording"),
+            std::string::npos)
+      << result.run.out;
+  const YAML::Node truth = YAML::LoadFile(stem(bag) + ".truth.yaml");
+  const double remount_s = truth["remount"]["time_s"].as<double>();
+  int first_after = 0;
+  for (const YAML::Node& interval : truth["stationary_intervals"]) {
+    if (interval[0].as<double>() > remount_s) break;
+    ++first_after;
+  }
+  EXPECT_NE(result.run.out.find("remount: mount changed before pose " +
+                                std::to_string(first_after) + " "),
+            std::string::npos)
+      << "expected pose " << first_after << "\n"
+      << result.run.out;
+  EXPECT_FALSE(std::filesystem::exists(temp("result.yaml")));
+  // The printed error to the truth (the mount after the change) is small.
+  const auto at = result.run.out.find("error to ");
+  ASSERT_NE(at, std::string::npos) << result.run.out;
+  const double error_deg = std::stod(result.run.out.substr(result.run.out.find(": ", at) + 2));
+  EXPECT_LT(error_deg, 0.2) << result.run.out;
+  removeBag(bag);
+}
+
 TEST(CalibrateBag, TruncatedBagExitsTwoWithoutCrashing) {
   const std::string bag = simulate("truncated", "--scenario nominal --seed 29 --num-poses 4");
   const auto size = std::filesystem::file_size(bag);
