@@ -233,6 +233,20 @@ TEST(DescribeStatus, ALoadedCalibrationShowsItsSource) {
   EXPECT_EQ(row(view, "latest estimate").value, "none yet");
 }
 
+TEST(DescribeStatus, TheBroadcastLatestEstimateWhenTheBroadcastFieldsAreEmpty) {
+  AlignmentStatus s = calibratedStatus();
+  s.has_broadcast = false;
+  s.q_broadcast = geometry_msgs::Quaternion();
+  StatusView view = describeStatus(s);
+  EXPECT_EQ(row(view, "broadcast").value, "[66.58, -61.35, -105.97]");
+  EXPECT_EQ(row(view, "broadcast").level, RowLevel::kGood);
+  EXPECT_EQ(row(view, "broadcast from").value, "the latest estimate");
+  s.broadcast = false;
+  view = describeStatus(s);
+  EXPECT_EQ(row(view, "broadcast").value, "nothing broadcast yet");
+  EXPECT_EQ(row(view, "broadcast from").value, "-");
+}
+
 TEST(DescribePoses, RowsWithRollPitchYawAndTheTurnFromThePreviousPose) {
   geometry_msgs::PoseArray poses;
   geometry_msgs::Pose pose;

@@ -1,14 +1,16 @@
 // The rviz panel plugin as rviz finds it: package.xml's <rviz plugin=...> export names
 // rviz_plugins.xml, which declares camera_imu_alignment/AlignmentPanel in a library that exists and
 // registers that class (PLUGINLIB_EXPORT_CLASS); the panel keeps its namespace and frame-label
-// switch through rviz's config (save, load). Fails when any link of that chain is broken. Needs the
-// workspace's environment (ROS_PACKAGE_PATH: the catkin test runner, or devel/setup.bash) and no
-// display (Qt's offscreen platform) and no ROS master (the panel subscribes only in onInitialize,
-// which rviz calls and this test does not).
+// switch through rviz's config (save, load); config/alignment.rviz loads it. Fails when any link of
+// that chain is broken. Needs the workspace's environment (ROS_PACKAGE_PATH: the catkin test
+// runner, or devel/setup.bash), no display (Qt's offscreen platform) and no ROS master (the panel
+// subscribes only in onInitialize, which rviz calls and this test does not).
 #include <gtest/gtest.h>
 #include <rviz/config.h>
 #include <rviz/panel.h>
 #include <pluginlib/class_loader.hpp>
+
+#include <yaml-cpp/yaml.h>
 
 #include <QApplication>
 #include <algorithm>
@@ -44,6 +46,20 @@ TEST(RvizPlugin, ThePanelIsExportedAndItsLibraryCreatesIt) {
   ASSERT_TRUE(panel);
   EXPECT_TRUE(panel->inherits("camera_imu_alignment::AlignmentPanel"));
   panel.reset();  // before the loader unloads the library
+}
+
+TEST(RvizPlugin, TheDefaultConfigLoadsThePanel) {
+  const YAML::Node config = YAML::LoadFile(ALIGNMENT_RVIZ);
+  pluginlib::ClassLoader<rviz::Panel> loader("rviz", "rviz::Panel");
+  int ours = 0;
+  for (const YAML::Node& panel : config["Panels"]) {
+    const std::string class_name = panel["Class"].as<std::string>();
+    if (class_name.rfind("camera_imu_alignment/", 0) != 0) continue;
+    ++ours;
+    EXPECT_TRUE(loader.isClassAvailable(class_name)) << ALIGNMENT_RVIZ << " names " << class_name;
+    EXPECT_EQ(panel["Namespace"].as<std::string>(), "/camera_imu_alignment");
+  }
+  EXPECT_EQ(ours, 1) << ALIGNMENT_RVIZ << " should load the alignment panel once";
 }
 
 TEST(RvizPlugin, ThePanelKeepsItsSettingsInTheRvizConfig) {

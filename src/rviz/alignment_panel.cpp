@@ -98,9 +98,10 @@ AlignmentPanel::AlignmentPanel(QWidget* parent) : rviz::Panel(parent) {
   notice_label_->setWordWrap(true);
   notice_label_->hide();
   status_table_ = makeTable(2, {});
-  poses_caption_ = new QLabel(
-      qt("Stationary poses in the window: the camera in the target frame, R_target_cam as " +
-         std::string(kRpyConvention) + "; turn: angle from the previous pose (deg)"));
+  poses_caption_ =
+      new QLabel(qt("Poses in the window: the camera in the target frame "
+                    "(R_target_cam), " +
+                    std::string(kRpyConvention) + "; turn from the previous pose"));
   poses_caption_->setWordWrap(true);
   pose_table_ = makeTable(6, {"#", "roll", "pitch", "yaw", "turn", "position (m)"});
   calibrate_button_ = new QPushButton("Calibrate");

@@ -16,7 +16,8 @@ namespace camera_imu_alignment {
 
 namespace {
 constexpr float kCharacterHeight_m = 0.035f;  // about the size of the TF display's own names
-}
+constexpr float kLabelOffset_m = 0.03f;       // camera label this far above, IMU label below
+}  // namespace
 
 FrameLabels::FrameLabels(rviz::DisplayContext* context) : context_(context) {
   root_ = context_->getSceneManager()->getRootSceneNode()->createChildSceneNode();
@@ -42,6 +43,7 @@ void FrameLabels::setLabel(Label& label, const std::string& frame, const std::st
   const std::string caption = role + ": " + frame;
   if (!label.text) {
     label.text = new rviz::MovableText(caption, "Liberation Sans", kCharacterHeight_m);
+    label.text->showOnTop();  // drawn over the axes that cross it
     label.node->attachObject(label.text);
   } else {
     label.text->setCaption(caption);
@@ -53,11 +55,16 @@ void FrameLabels::setFrames(const std::string& camera_frame, const std::string& 
   setLabel(camera_, camera_frame, "camera");
   setLabel(imu_, imu_frame, "IMU");
   setLabel(target_, target_frame, "target");
-  // Camera above its origin, IMU below the same origin: never on top of each other.
-  if (camera_.text)
+  // Camera above its origin, IMU below the same origin (along the fixed frame's z, up in rviz's
+  // usual views) with a gap between them: never on top of each other, clear of the axes' ends.
+  if (camera_.text) {
     camera_.text->setTextAlignment(rviz::MovableText::H_CENTER, rviz::MovableText::V_ABOVE);
-  if (imu_.text)
+    camera_.text->setGlobalTranslation(Ogre::Vector3(0.0f, 0.0f, kLabelOffset_m));
+  }
+  if (imu_.text) {
     imu_.text->setTextAlignment(rviz::MovableText::H_CENTER, rviz::MovableText::V_BELOW);
+    imu_.text->setGlobalTranslation(Ogre::Vector3(0.0f, 0.0f, -kLabelOffset_m));
+  }
   if (target_.text)
     target_.text->setTextAlignment(rviz::MovableText::H_CENTER, rviz::MovableText::V_BELOW);
 }

@@ -206,10 +206,16 @@ StatusView describeStatus(const AlignmentStatus& s) {
   if (s.has_broadcast) {
     rows.push_back(rpyRow("broadcast", s.q_broadcast, ""));
     rows.back().level = rows.back().level == RowLevel::kError ? RowLevel::kError : RowLevel::kGood;
+    rows.push_back(broadcastSourceRow(s));
+  } else if (s.has_estimate && s.broadcast) {
+    // A node that says the latest estimate is broadcast without filling the broadcast fields.
+    rows.push_back(rpyRow("broadcast", s.q_cam_imu, ""));
+    rows.back().level = rows.back().level == RowLevel::kError ? RowLevel::kError : RowLevel::kGood;
+    rows.push_back({"broadcast from", "the latest estimate", RowLevel::kNormal, ""});
   } else {
     rows.push_back({"broadcast", "nothing broadcast yet", RowLevel::kNormal, ""});
+    rows.push_back(broadcastSourceRow(s));
   }
-  rows.push_back(broadcastSourceRow(s));
   rows.push_back(consistencyRow(s));
   rows.push_back({"remounts", std::to_string(s.remounts),
                   s.remounts > 0 ? RowLevel::kWarning : RowLevel::kNormal,
@@ -257,7 +263,7 @@ PanelRow describeCalibrateAnswer(const Calibrate::Request& request,
   } else {
     row.level = RowLevel::kWarning;
     row.value = "solved, not broadcast: " + (response.not_broadcast_reason.empty()
-                                                 ? std::string("(no reason given)")
+                                                 ? std::string("(the node gave no reason)")
                                                  : response.not_broadcast_reason);
   }
   const std::optional<std::string> rpy = rpyText(response.q_cam_imu);

@@ -52,9 +52,11 @@ struct StatusView {
 /// Rows, in this order: poses (window / total, rests), pairs (kept), residual RMS, 1-sigma
 /// (x, y, z), observability, rotate about next, IMU guidance, the rpy convention, latest
 /// estimate rpy, broadcast rpy, broadcast (source, poses, 1-sigma), consistency (chi2, dof,
-/// p_value), remounts, last pose. Values the message does not carry (no estimate, nothing
-/// broadcast, no statistics) read "-" or say so; a non-finite number or a quaternion that is not
-/// a rotation reads "invalid (...)" with level kError: never "nan".
+/// p_value), remounts, last pose. Without `has_broadcast`, a latest estimate flagged `broadcast` is
+/// shown as the broadcast one (a node that does not fill the broadcast fields). Values the message
+/// does not carry (no estimate, nothing broadcast, no statistics) read "-" or say so; a non-finite
+/// number or a quaternion that is not a rotation reads "invalid (...)" with level kError: never
+/// "nan".
 StatusView describeStatus(const AlignmentStatus& status);
 
 /// Roll, pitch, yaw (deg) of a quaternion message, e.g. "[66.58, -61.35, -105.97]"; nullopt when
