@@ -1,20 +1,14 @@
-// The rviz panel's text (src/rviz/panel_text.cpp) and its background service calls
-// (src/rviz/background_calls.cpp), without a display and without a ROS master: roll, pitch, yaw
-// against rotations built from known angles, every ~status field in its row, no "nan" ever, the
-// pose list's turn angles, the service answers, the namespace rules, the IMU frame found in a tf
-// tree, and calls that never block the caller.
+// The rviz panel's text (src/rviz/panel_text.cpp), without a display and without a ROS master:
+// roll, pitch, yaw against rotations built from known angles, every ~status field in its row, no
+// "nan" ever, the pose list's turn angles, the service answers, the namespace rules, the IMU frame
+// found in a tf tree. Its background calls: test_background_calls.cpp (the same binary).
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-#include <chrono>
 #include <cmath>
-#include <future>
 #include <limits>
-#include <memory>
 #include <regex>
-#include <thread>
 
-#include "camera_imu_alignment/rviz/background_calls.h"
 #include "camera_imu_alignment/rviz/panel_text.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 
@@ -364,77 +358,6 @@ TEST(FindImuFrame, TheCameraFramesOtherNeighbour) {
   EXPECT_EQ(findImuFrame(camera, target, {{"imu_link", camera}, {"lidar", camera}}), "");
   EXPECT_EQ(findImuFrame("", target, {{"imu_link", camera}}), "");
   EXPECT_EQ(findImuFrame(camera, target, {}), "");
-}
-
-/// Polls takeFinished() until something arrives or `timeout` passes.
-std::vector<BackgroundCalls::Finished> waitForAnswers(BackgroundCalls& calls,
-                                                      std::chrono::milliseconds timeout) {
-  const auto until = std::chrono::steady_clock::now() + timeout;
-  while (std::chrono::steady_clock::now() < until) {
-    std::vector<BackgroundCalls::Finished> finished = calls.takeFinished();
-    if (!finished.empty()) return finished;
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  return {};
-}
-
-TEST(BackgroundCalls, StartReturnsAtOnceWhileTheCallBlocks) {
-  BackgroundCalls calls;
-  std::promise<void> release;
-  std::shared_future<void> released = release.get_future().share();
-  const auto before = std::chrono::steady_clock::now();
-  ASSERT_TRUE(calls.start("calibrate", [released]() {
-    released.wait();  // a service that takes its time
-    return PanelRow{"calibrate", "broadcast", RowLevel::kGood, ""};
-  }));
-  EXPECT_LT(std::chrono::steady_clock::now() - before, std::chrono::milliseconds(500));
-  EXPECT_TRUE(calls.pending("calibrate"));
-  EXPECT_FALSE(calls.pending("save"));
-  // One call per service at a time; other services are independent.
-  EXPECT_FALSE(calls.start("calibrate", [] { return PanelRow{}; }));
-  EXPECT_TRUE(calls.start("save", [] { return PanelRow{"save", "done", RowLevel::kGood, ""}; }));
-  std::vector<BackgroundCalls::Finished> finished =
-      waitForAnswers(calls, std::chrono::milliseconds(5000));
-  ASSERT_EQ(finished.size(), 1u);
-  EXPECT_EQ(finished[0].key, "save");
-  EXPECT_TRUE(calls.takeFinished().empty());
-  EXPECT_TRUE(calls.pending("calibrate"));
-  release.set_value();
-  finished = waitForAnswers(calls, std::chrono::milliseconds(5000));
-  ASSERT_EQ(finished.size(), 1u);
-  EXPECT_EQ(finished[0].key, "calibrate");
-  EXPECT_EQ(finished[0].answer.value, "broadcast");
-  EXPECT_FALSE(calls.pending("calibrate"));
-  EXPECT_DOUBLE_EQ(calls.pendingSeconds("calibrate"), 0.0);
-}
-
-TEST(BackgroundCalls, AnExceptionBecomesAnErrorAnswer) {
-  BackgroundCalls calls;
-  ASSERT_TRUE(
-      calls.start("reset", []() -> PanelRow { throw std::runtime_error("connection refused"); }));
-  const std::vector<BackgroundCalls::Finished> finished =
-      waitForAnswers(calls, std::chrono::milliseconds(5000));
-  ASSERT_EQ(finished.size(), 1u);
-  EXPECT_EQ(finished[0].answer.level, RowLevel::kError);
-  EXPECT_EQ(finished[0].answer.value, "the call failed: connection refused");
-}
-
-TEST(BackgroundCalls, ACallMayOutliveItsOwner) {
-  std::promise<void> release;
-  std::shared_future<void> released = release.get_future().share();
-  auto ended = std::make_shared<std::promise<void>>();
-  std::future<void> call_ended = ended->get_future();
-  auto calls = std::make_unique<BackgroundCalls>(std::chrono::milliseconds(20));
-  ASSERT_TRUE(calls->start("calibrate", [released, ended]() {
-    released.wait();
-    ended->set_value();
-    return PanelRow{"calibrate", "late", RowLevel::kGood, ""};
-  }));
-  const auto before = std::chrono::steady_clock::now();
-  calls.reset();  // rviz closes during a call: the destructor waits 20 ms, not for the call
-  EXPECT_LT(std::chrono::steady_clock::now() - before, std::chrono::milliseconds(1000));
-  release.set_value();  // the call ends after its owner is gone: no crash, the answer dropped
-  EXPECT_EQ(call_ended.wait_for(std::chrono::seconds(5)), std::future_status::ready);
 }
 
 }  // namespace
