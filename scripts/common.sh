@@ -20,6 +20,7 @@ CIA_PACKAGES=(
   libnodelet-dev libimage-transport-dev libtf2-dev libtf2-msgs-dev libtf2-ros-dev
   libdiagnostic-updater-dev libdiagnostic-msgs-dev tf2-tools libcv-bridge-dev libtf2-eigen-dev
   python3-std-srvs python3-diagnostic-msgs
+  librviz-dev rviz qtbase5-dev
   catkin-lint clang-format
 )
 
