@@ -129,6 +129,18 @@ JointSimulation simulateJointProblem(const JointSimulationOptions& o, uint64_t s
                    : Eigen::Vector3d(level[k - 1] + o.gyro_bias_step_rad_s * random.normal3());
   }
   Eigen::Vector3d walk = Eigen::Vector3d::Zero();
+  // The accelerometer bias walks through rests and motions alike, from the first rest's bias.
+  Random accel_random(seed ^ 0x5eedacce1ULL);
+  const double accel_walk_step = noise ? o.accel_bias_walk / std::sqrt(o.rate_hz) : 0.0;
+  Eigen::Vector3d accel_bias = sim.accel_bias_m_s2;
+  auto walkAccelBias = [&](int samples) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int i = 0; i < samples; ++i) {
+      if (accel_walk_step > 0.0) accel_bias += accel_walk_step * accel_random.normal3();
+      sum += accel_bias;
+    }
+    return Eigen::Vector3d(sum / std::max(samples, 1));
+  };
   double t = 100.0;
   const Eigen::Matrix3d& X = sim.R_cam_imu;
   for (int k = 0; k < n; ++k) {
@@ -156,8 +168,10 @@ JointSimulation simulateJointProblem(const JointSimulationOptions& o, uint64_t s
     pose.gyro_mean_cov = gyro_mean_sigma * gyro_mean_sigma * Eigen::Matrix3d::Identity();
 
     const double accel_mean_sigma = o.accel_noise_m_s2 * mean_scale;
-    pose.accel_mean_m_s2 =
-        sim.T_a * R.transpose() * Eigen::Vector3d(0.0, 0.0, o.gravity_m_s2) + sim.accel_bias_m_s2;
+    sim.accel_bias_rest_mean.push_back(walkAccelBias(rest_samples));
+    if (k == 0) sim.accel_bias_m_s2 = sim.accel_bias_rest_mean[0];
+    pose.accel_mean_m_s2 = sim.T_a * R.transpose() * Eigen::Vector3d(0.0, 0.0, o.gravity_m_s2) +
+                           sim.accel_bias_rest_mean.back();
     if (noise) pose.accel_mean_m_s2 += accel_mean_sigma * random.normal3();
     pose.accel_mean_cov = accel_mean_sigma * accel_mean_sigma * Eigen::Matrix3d::Identity();
 
@@ -201,6 +215,7 @@ JointSimulation simulateJointProblem(const JointSimulationOptions& o, uint64_t s
         segment.gyro_rad_s.push_back(w);
       }
       if (joined && o.with_gyro) sim.problem.segments.push_back(std::move(segment));
+      walkAccelBias(motion_samples + (joined ? 0 : static_cast<int>(10.0 * o.rate_hz)));
       t = motion_end;
     }
   }

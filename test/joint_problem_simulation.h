@@ -39,7 +39,10 @@ struct JointSimulationOptions {
   double gyro_noise_density = 1.7e-4;  ///< rad/s/sqrt(Hz)
   double gyro_bias_walk = 1e-4;        ///< rad/s/sqrt(s); 0 without noise
   double gyro_bias_step_rad_s = 0.0;   ///< bias level change per rest (1-sigma), ramped
-  double mag_noise_t = 0.3e-6;         ///< per sample
+  /// Accelerometer bias random walk (m/s^2/sqrt(s); 0 without noise): the default prior's. Drawn
+  /// from a random stream of its own, so that it leaves every other draw of a seed unchanged.
+  double accel_bias_walk = 1e-3;
+  double mag_noise_t = 0.3e-6;  ///< per sample
   double gravity_m_s2 = 9.81;
   double field_t = 50e-6, dip_rad = 60.0 * 3.14159265358979323846 / 180.0;
 
@@ -57,8 +60,9 @@ struct JointSimulation {
   Eigen::Matrix3d R_cam_imu, R_world_target;
   std::vector<Eigen::Matrix3d> R_world_imu;
   Eigen::Matrix3d T_g, T_a, soft_iron;
-  Eigen::Vector3d accel_bias_m_s2, hard_iron_t;
-  std::vector<Eigen::Vector3d> gyro_bias_rest_mean;  ///< true mean bias over each rest (rad/s)
+  Eigen::Vector3d accel_bias_m_s2, hard_iron_t;       ///< accel_bias_m_s2: at the first rest
+  std::vector<Eigen::Vector3d> accel_bias_rest_mean;  ///< true mean bias over each rest (m/s^2)
+  std::vector<Eigen::Vector3d> gyro_bias_rest_mean;   ///< true mean bias over each rest (rad/s)
 };
 
 JointSimulation simulateJointProblem(const JointSimulationOptions& options, uint64_t seed);

@@ -172,6 +172,7 @@ inline JointSettings jointSettingsFor(const simulation::SimulationConfig& c) {
     s.priors.soft_iron_scale = s.priors.soft_iron_cross = std::max(0.005, e.mag_soft_iron_sigma);
   }
   s.priors.accel_bias_m_s2 = std::max(0.01, 2.0 * c.imu_noise.accelerometer_initial_bias_sigma);
+  s.priors.accel_bias_walk_m_s2_sqrt_s = c.imu_noise.accelerometer_random_walk;
   return s;
 }
 

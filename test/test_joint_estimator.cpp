@@ -58,6 +58,11 @@ TEST(JointEstimator, NoiseFreeExactRecovery) {
       EXPECT_LT((r.intrinsics.gyro_matrix - sim.T_g).cwiseAbs().maxCoeff(), 1e-8);
       EXPECT_LT((r.intrinsics.accel_matrix - sim.T_a).cwiseAbs().maxCoeff(), 1e-8);
       EXPECT_LT((r.intrinsics.accel_bias_m_s2 - sim.accel_bias_m_s2).norm(), 1e-7);
+      ASSERT_EQ(r.intrinsics.accel_bias_per_pose_m_s2.size(), sim.accel_bias_rest_mean.size());
+      for (size_t k = 0; k < sim.accel_bias_rest_mean.size(); ++k) {
+        EXPECT_LT((r.intrinsics.accel_bias_per_pose_m_s2[k] - sim.accel_bias_rest_mean[k]).norm(),
+                  1e-7);
+      }
       EXPECT_LT((r.intrinsics.gyro_bias_rad_s - sim.gyro_bias_rest_mean[0]).norm(), 1e-9);
       EXPECT_EQ(r.intrinsics.magnetometer_used, magnetometer);
       if (magnetometer) {
@@ -202,7 +207,8 @@ TEST(JointEstimator, RobustLossLimitsABadCameraPose) {
       errorDeg(solveSimulation(clean), clean));
   EXPECT_LT(errorDeg(huber, sim), errorDeg(least_squares, sim));
   EXPECT_LT(errorDeg(cauchy_result, sim), errorDeg(least_squares, sim));
-  EXPECT_LT(errorDeg(huber, sim), 0.1);
+  // With the robust loss the 2 deg outlier costs little over the clean estimate (0.086 deg here).
+  EXPECT_LT(errorDeg(huber, sim), errorDeg(solveSimulation(clean), clean) + 0.04);
   // The bad pose stands out in the per-pose residuals.
   const auto worst =
       std::max_element(huber.pose_residual_norm.begin(), huber.pose_residual_norm.end());

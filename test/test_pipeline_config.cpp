@@ -43,6 +43,7 @@ PipelineSettings scrambled() {
   s.joint.priors.accel_scale = 7;
   s.joint.priors.accel_cross_axis = 7;
   s.joint.priors.accel_bias_m_s2 = 7;
+  s.joint.priors.accel_bias_walk_m_s2_sqrt_s = 7;
   s.joint.priors.soft_iron_scale = 7;
   s.joint.priors.soft_iron_cross = 7;
   s.joint.priors.hard_iron_t = 7;
@@ -93,6 +94,7 @@ void expectDefaults(const PipelineSettings& s) {
   EXPECT_EQ(s.joint.priors.accel_scale, d.joint.priors.accel_scale);
   EXPECT_EQ(s.joint.priors.accel_cross_axis, d.joint.priors.accel_cross_axis);
   EXPECT_EQ(s.joint.priors.accel_bias_m_s2, d.joint.priors.accel_bias_m_s2);
+  EXPECT_EQ(s.joint.priors.accel_bias_walk_m_s2_sqrt_s, d.joint.priors.accel_bias_walk_m_s2_sqrt_s);
   EXPECT_EQ(s.joint.priors.soft_iron_scale, d.joint.priors.soft_iron_scale);
   EXPECT_EQ(s.joint.priors.soft_iron_cross, d.joint.priors.soft_iron_cross);
   EXPECT_EQ(s.joint.priors.hard_iron_t, d.joint.priors.hard_iron_t);

@@ -54,6 +54,7 @@ State initialState(const JointProblem& problem, const Eigen::Matrix3d& R_cam_imu
   state.R_cam_imu_0 = projectToSO3(R_cam_imu_initial);
   state.R_cam_imu_after_0 = state.R_cam_imu_0;
   state.delta.assign(n, {0.0, 0.0, 0.0});
+  state.accel_bias.assign(n, {0.0, 0.0, 0.0});
   state.gyro_bias.resize(n);
   for (size_t k = 0; k < n; ++k) {
     const Eigen::Vector3d& b = problem.poses[k].gyro_mean_rad_s;

@@ -15,6 +15,9 @@ namespace camera_imu_alignment {
 namespace joint {
 namespace {
 
+/// Shortest time between two rests' centres a walk residual assumes (s): keeps its sigma > 0.
+constexpr double kMinWalkDt = 1e-3;
+
 ceres::LossFunction* makeLoss(const JointSettings& settings) {
   switch (settings.robust_loss) {
     case RobustLossKind::kHuber:
@@ -98,16 +101,17 @@ class Builder {
   }
 
   void addAccelerometer() {
+    const size_t n = problem_.poses.size();
     addBlock(state_.accel_matrix.data(), 6);
-    addBlock(state_.accel_bias.data(), 3);
-    for (size_t k = 0; k < problem_.poses.size(); ++k) {
+    for (size_t k = 0; k < n; ++k) addBlock(state_.accel_bias[k].data(), 3);
+    for (size_t k = 0; k < n; ++k) {
       const JointPose& pose = problem_.poses[k];
       auto* accel = new ceres::AutoDiffCostFunction<AccelResidual, 3, 3, 3, 3, 6, 3>(
           new AccelResidual{targetCam(k), cameraImu0(k), pose.accel_mean_m_s2, whitening_.accel[k],
                             settings_.gravity_m_s2, settings_.accel_matrix_form});
       record(ceres_.AddResidualBlock(accel, loss_, state_.e_T.data(), cameraImuIncrement(k),
                                      state_.delta[k].data(), state_.accel_matrix.data(),
-                                     state_.accel_bias.data()),
+                                     state_.accel_bias[k].data()),
              static_cast<int>(k), -1, 3);
       auto* camera = new ceres::NormalPrior(whitening_.camera[k], ceres::Vector::Zero(3));
       record(ceres_.AddResidualBlock(camera, loss_, state_.delta[k].data()), static_cast<int>(k),
@@ -125,13 +129,26 @@ class Builder {
       holdBlock(state_.accel_matrix.data());
     }
     if (observability_.accel_bias_estimated || !pin_) {
+      // The prior holds the first pose's bias, the walk each next one's.
       record(ceres_.AddResidualBlock(
                  maskedPrior(3, {0, 1, 2}, std::vector<double>(3, p.accel_bias_m_s2)), nullptr,
-                 state_.accel_bias.data()),
+                 state_.accel_bias[0].data()),
              -1, -1, 3);
+      for (size_t k = 0; k + 1 < n; ++k) {
+        const double dt = std::max(std::abs(restCentre(k + 1) - restCentre(k)), kMinWalkDt);
+        auto* walk = new ceres::AutoDiffCostFunction<BiasWalkResidual, 3, 3, 3>(
+            new BiasWalkResidual{1.0 / (p.accel_bias_walk_m_s2_sqrt_s * std::sqrt(dt))});
+        record(ceres_.AddResidualBlock(walk, nullptr, state_.accel_bias[k].data(),
+                                       state_.accel_bias[k + 1].data()),
+               static_cast<int>(k), static_cast<int>(k + 1), 3);
+      }
     } else {
-      holdBlock(state_.accel_bias.data());
+      for (size_t k = 0; k < n; ++k) holdBlock(state_.accel_bias[k].data());
     }
+  }
+
+  double restCentre(size_t k) const {
+    return 0.5 * (problem_.poses[k].start_s + problem_.poses[k].end_s);
   }
 
   void addMagnetometer() {
@@ -188,7 +205,7 @@ class Builder {
       const JointPose& a = problem_.poses[k];
       const JointPose& b = problem_.poses[k + 1];
       if (!with_gyro[k] || !with_gyro[k + 1] || a.group != b.group) continue;
-      const double dt = std::max(0.5 * (b.start_s + b.end_s - a.start_s - a.end_s), 1e-3);
+      const double dt = std::max(restCentre(k + 1) - restCentre(k), kMinWalkDt);
       auto* cost = new ceres::AutoDiffCostFunction<BiasWalkResidual, 3, 3, 3>(
           new BiasWalkResidual{1.0 / (walk * std::sqrt(dt))});
       record(ceres_.AddResidualBlock(cost, nullptr, state_.gyro_bias[k].data(),

@@ -185,10 +185,14 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
   in.accel_matrix_sigma = sixToMatrix(accel_sigma, symmetric);
   in.accel_matrix_estimated = observability.accel_matrix_estimated;
   const Eigen::VectorXd accel_bias_sigma =
-      blockSigma(*used, requested, state.accel_bias.data(),
+      blockSigma(*used, requested, state.accel_bias[0].data(),
                  Eigen::Vector3d::Constant(p.accel_bias_m_s2), scale);
-  in.accel_bias_m_s2 = toVector(state.accel_bias.data(), 3);
+  in.accel_bias_m_s2 = state.accelBias(0);
   in.accel_bias_sigma_m_s2 = accel_bias_sigma;
+  in.accel_bias_per_pose_m_s2.clear();
+  for (size_t k = 0; k < n; ++k) {
+    in.accel_bias_per_pose_m_s2.push_back(state.accelBias(static_cast<int>(k)));
+  }
   in.accel_bias_estimated = observability.accel_bias_estimated;
 
   const bool has_gyro = !problem.segments.empty();

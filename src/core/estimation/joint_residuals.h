@@ -4,7 +4,7 @@
 //   e_X (3)     R_cam_imu = Exp(e_X) X0              (rad, camera axes: left perturbation)
 //   e_T (3)     R_world_target = Exp(e_T) T0         (rad, world axes; z held without magnetometer)
 //   delta_k (3) R_target_cam_k' = R_target_cam_k Exp(delta_k)   (rad, camera axes)
-//   accel_matrix (6)  T_a - I (AccelMatrixForm);  accel_bias (3) m/s^2
+//   accel_matrix (6)  T_a - I (AccelMatrixForm);  accel_bias_k (3) m/s^2, per pose
 //   gyro_matrix (9)   T_g - I, row-major;         gyro_bias_k (3) rad/s, per pose
 //   soft_iron (6)     S_m - I symmetric: [xx, yy, zz, xy, xz, yz]
 //   hard_iron (3) uT;  field (2) uT: m_world = (0, field[0], field[1])
@@ -204,9 +204,9 @@ struct GyroResidual {
   }
 };
 
-/// Gyro bias random walk between consecutive rests: r = (b_to - b_from) / sigma.
+/// Bias random walk (gyro or accelerometer) between consecutive rests: r = (b_to - b_from) / sigma.
 struct BiasWalkResidual {
-  double inverse_sigma;  // 1 / (walk * sqrt(dt))
+  double inverse_sigma;  // 1 / (walk * sqrt(dt)), in the bias' inverse units
 
   template <typename T>
   bool operator()(const T* bias_from, const T* bias_to, T* residual) const {

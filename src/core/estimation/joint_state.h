@@ -28,17 +28,18 @@ struct State {
   /// Exp(e_X_after) X0_after.
   Eigen::Matrix3d R_cam_imu_after_0 = Eigen::Matrix3d::Identity();
   std::array<double, 3> e_X_after{};
-  std::vector<std::array<double, 3>> delta;      ///< per pose (rad)
-  std::array<double, 6> accel_matrix{};          ///< T_a - I
-  std::array<double, 3> accel_bias{};            ///< m/s^2
-  std::array<double, 9> gyro_matrix{};           ///< T_g - I, row-major
-  std::vector<std::array<double, 3>> gyro_bias;  ///< per pose (rad/s)
-  std::array<double, 6> soft_iron{};             ///< S_m - I: [xx, yy, zz, xy, xz, yz]
+  std::vector<std::array<double, 3>> delta;       ///< per pose (rad)
+  std::array<double, 6> accel_matrix{};           ///< T_a - I
+  std::vector<std::array<double, 3>> accel_bias;  ///< per pose (m/s^2)
+  std::array<double, 9> gyro_matrix{};            ///< T_g - I, row-major
+  std::vector<std::array<double, 3>> gyro_bias;   ///< per pose (rad/s)
+  std::array<double, 6> soft_iron{};              ///< S_m - I: [xx, yy, zz, xy, xz, yz]
   std::array<double, 3> hard_iron_ut{};
   std::array<double, 2> field_ut{};  ///< m_world = (0, field[0], field[1]) uT
 
   Eigen::Matrix3d gyroMatrix() const;  ///< T_g
   Eigen::Vector3d gyroBias(int pose) const;
+  Eigen::Vector3d accelBias(int pose) const;
   /// Folds e_X and e_T into X0 and T0 (then zero).
   void foldRotationIncrements();
   /// Puts the columns of T_g that `observability` does not estimate back at their prior (I).

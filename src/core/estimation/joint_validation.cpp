@@ -28,9 +28,10 @@ bool usableCovariance(const Eigen::Matrix3d& covariance, double floor_sigma) {
 
 std::string validateSettings(const JointSettings& s) {
   const ImuModelPriors& p = s.priors;
-  for (double sigma : {p.gyro_scale, p.gyro_cross_axis, p.gyro_bias_walk_rad_s_sqrt_s,
-                       p.accel_scale, p.accel_cross_axis, p.accel_bias_m_s2, p.soft_iron_scale,
-                       p.soft_iron_cross, p.hard_iron_t}) {
+  for (double sigma :
+       {p.gyro_scale, p.gyro_cross_axis, p.gyro_bias_walk_rad_s_sqrt_s, p.accel_scale,
+        p.accel_cross_axis, p.accel_bias_m_s2, p.accel_bias_walk_m_s2_sqrt_s, p.soft_iron_scale,
+        p.soft_iron_cross, p.hard_iron_t}) {
     if (!finitePositive(sigma)) return "settings: every prior sigma must be finite and > 0";
   }
   for (double floor :
@@ -246,6 +247,10 @@ Eigen::Matrix3d State::gyroMatrix() const {
 
 Eigen::Vector3d State::gyroBias(int pose) const {
   return Eigen::Vector3d(gyro_bias[pose][0], gyro_bias[pose][1], gyro_bias[pose][2]);
+}
+
+Eigen::Vector3d State::accelBias(int pose) const {
+  return Eigen::Vector3d(accel_bias[pose][0], accel_bias[pose][1], accel_bias[pose][2]);
 }
 
 void State::foldRotationIncrements() {

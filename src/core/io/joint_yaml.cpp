@@ -77,7 +77,12 @@ std::string jointToYaml(const JointResult& j) {
       << ", estimated: " << boolText(i.accel_matrix_estimated) << "}\n";
   out << "  accel_bias_m_s2: {value: " << flow(i.accel_bias_m_s2)
       << ", sigma: " << flow(i.accel_bias_sigma_m_s2)
-      << ", estimated: " << boolText(i.accel_bias_estimated) << "}\n";
+      << ", estimated: " << boolText(i.accel_bias_estimated) << "}  # at the first pose\n";
+  out << "  accel_bias_per_pose_m_s2: [";
+  for (size_t k = 0; k < i.accel_bias_per_pose_m_s2.size(); ++k) {
+    out << (k ? ", " : "") << flow(i.accel_bias_per_pose_m_s2[k]);
+  }
+  out << "]  # the bias walks: one per pose, in pose order\n";
   out << "  magnetometer_used: " << boolText(i.magnetometer_used) << "\n";
   out << "  soft_iron: {value: " << flow(i.soft_iron) << ", sigma: " << flow(i.soft_iron_sigma)
       << ", estimated: " << boolText(i.soft_iron_estimated) << "}\n";

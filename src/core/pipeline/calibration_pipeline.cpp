@@ -102,6 +102,7 @@ std::string PipelineSettings::validate() const {
       {"imu_prior_accel_scale", joint.priors.accel_scale},
       {"imu_prior_accel_cross_axis", joint.priors.accel_cross_axis},
       {"imu_prior_accel_bias_m_s2", joint.priors.accel_bias_m_s2},
+      {"imu_prior_accel_bias_walk_m_s2_sqrt_s", joint.priors.accel_bias_walk_m_s2_sqrt_s},
       {"imu_prior_soft_iron_scale", joint.priors.soft_iron_scale},
       {"imu_prior_soft_iron_cross", joint.priors.soft_iron_cross},
       {"imu_prior_hard_iron_t", joint.priors.hard_iron_t},

@@ -92,6 +92,9 @@ const std::vector<Key>& keys() {
           "imu_prior_accel_bias_m_s2", [](auto* s) { return &s->joint.priors.accel_bias_m_s2; },
           kPositive),
       number<double>(
+          "imu_prior_accel_bias_walk_m_s2_sqrt_s",
+          [](auto* s) { return &s->joint.priors.accel_bias_walk_m_s2_sqrt_s; }, kPositive),
+      number<double>(
           "imu_prior_soft_iron_scale", [](auto* s) { return &s->joint.priors.soft_iron_scale; },
           kPositive),
       number<double>(
