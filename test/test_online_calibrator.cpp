@@ -55,10 +55,12 @@ struct Run {
 };
 
 std::unique_ptr<Run> calibrate(const sim::SimulationConfig& c, OnlineSettings online = {},
-                               bool finish = true) {
+                               bool finish = true,
+                               ImuOrientationSource source = ImuOrientationSource::kJoint) {
   auto run = std::make_unique<Run>();
   run->simulated = std::make_unique<sim::SimulationRun>(c);
   PipelineSettings settings;
+  settings.imu_orientation = source;
   settings.joint = test::jointSettingsFor(c);
   run->calibrator =
       std::make_unique<OnlineCalibrator>(parseTargetYaml(sim::targetYaml(c.target), "target"),
@@ -145,6 +147,22 @@ TEST(OnlineCalibrator, RemountBeforeTheFirstBroadcastIsFoundWithinThreePoses) {
       EXPECT_LE(b.poses, static_cast<int>(r.poses.size()) - first_after) << what;
     }
   }
+}
+
+TEST(OnlineCalibrator, PairModesKeepTheResidualRemountTest) {
+  // imu_orientation auto (the gyro chain's pairs, no joint estimate): remount_poses poses in a row
+  // off the broadcast estimate by more than remount_residual_deg restart the window from them.
+  sim::SimulationConfig c;
+  c.seed = 43;
+  ASSERT_TRUE(sim::applyScenario("remount", &c));  // 16 poses, 10 deg about camera y halfway
+  const auto run = calibrate(c, synchronous(), true, ImuOrientationSource::kAuto);
+  const Recorder& r = run->recorder;
+  ASSERT_EQ(r.remounts.size(), 1u) << run->calibrator->stateMessage();
+  EXPECT_NE(r.remounts[0].message.find("remount_residual_deg"), std::string::npos);
+  ASSERT_TRUE(run->calibrator->broadcast().has_value());
+  EXPECT_LT(errorDeg(run->calibrator->broadcast()->R_cam_imu,
+                     run->simulated->trajectory.R_cam_imu_final()),
+            0.3);
 }
 
 TEST(OnlineCalibrator, NoFalseRemountOnUnchangedRecordings) {

@@ -97,6 +97,8 @@ struct OnlineCalibrator::Impl {
   void poll();
   void apply(SolveOutput output);
   void applyRemount(const SolveOutput& output);
+  /// Keeps the window's poses from `first_index` on and says so (state, on_remount).
+  void restartWindowAt(int first_index, double change_deg, const std::string& text);
   void applyEstimate(EstimateEvent event);
   void doBroadcast(const AlignmentResult& result, std::size_t poses);
 };
@@ -168,19 +170,24 @@ void OnlineCalibrator::Impl::checkPairRemount(const StationaryPose& pose) {
   inconsistent_poses = rms_deg > settings.remount_residual_deg ? inconsistent_poses + 1 : 0;
   if (inconsistent_poses < settings.remount_poses) return;
   const int first_index = pose.index - settings.remount_poses + 1;
-  pipeline->keepNewestPoses(static_cast<std::size_t>(settings.remount_poses));
-  ++generation;
-  ++remounts;
-  inconsistent_poses = 0;
-  recalibrating = fresh_start = true;
   char text[256];
   std::snprintf(text, sizeof(text),
                 "mount changed before pose %d: the last %d poses disagree with the broadcast "
                 "estimate by more than remount_residual_deg %.2f deg; window restarted from them",
                 first_index, settings.remount_poses, settings.remount_residual_deg);
+  restartWindowAt(first_index, 0.0, text);
+}
+
+void OnlineCalibrator::Impl::restartWindowAt(int first_index, double change_deg,
+                                             const std::string& text) {
+  pipeline->keepPosesFrom(first_index);
+  ++generation;  // solves still running saw the old mount's poses
+  ++remounts;
+  inconsistent_poses = 0;
+  recalibrating = fresh_start = true;
   setState(CalibrationState::kRecalibrating, text);
   if (callbacks.on_remount) {
-    callbacks.on_remount({first_index, 0.0, pipeline->windowSize(), text});
+    callbacks.on_remount({first_index, change_deg, pipeline->windowSize(), text});
   }
 }
 
@@ -219,21 +226,15 @@ void OnlineCalibrator::Impl::apply(SolveOutput output) {
 void OnlineCalibrator::Impl::applyRemount(const SolveOutput& output) {
   const MountChangeTest& test = *output.mount_test;
   const int first_index = output.window.pose_indices.at(test.first_pose_after);
-  pipeline->keepPosesFrom(first_index);
-  ++generation;
-  ++remounts;
-  inconsistent_poses = 0;
-  recalibrating = fresh_start = true;
+  const std::size_t kept = static_cast<std::size_t>(
+      std::count_if(output.window.pose_indices.begin(), output.window.pose_indices.end(),
+                    [&](int index) { return index >= first_index; }));
   char text[320];
   std::snprintf(text, sizeof(text),
                 "mount changed before pose %d (by %.2f deg; chi-square change test p %.2g < "
                 "remount_level %.2g): window restarted from the %zu poses after it",
-                first_index, test.change_deg, test.p_value, settings.remount.level,
-                pipeline->windowSize());
-  setState(CalibrationState::kRecalibrating, text);
-  if (callbacks.on_remount) {
-    callbacks.on_remount({first_index, test.change_deg, pipeline->windowSize(), text});
-  }
+                first_index, test.change_deg, test.p_value, settings.remount.level, kept);
+  restartWindowAt(first_index, test.change_deg, text);
   if (static_cast<int>(pipeline->windowSize()) >= pipeline_settings.min_poses_to_solve) {
     requestSolve();
   }
