@@ -37,6 +37,7 @@ PipelineSettings scrambled() {
   s.max_gyro_span_s = 7;
   s.imu_orientation = ImuOrientationSource::kMagnetometer;
   s.accel_weight = 0.7;
+  s.joint.imu_matrices = ImuMatrixModel::kIdentity;
   s.joint.priors.gyro_scale = 7;
   s.joint.priors.gyro_cross_axis = 7;
   s.joint.priors.gyro_bias_walk_rad_s_sqrt_s = 7;
@@ -88,6 +89,7 @@ void expectDefaults(const PipelineSettings& s) {
   EXPECT_EQ(s.max_gyro_span_s, d.max_gyro_span_s);
   EXPECT_EQ(s.imu_orientation, d.imu_orientation);
   EXPECT_EQ(s.accel_weight, d.accel_weight);
+  EXPECT_EQ(s.joint.imu_matrices, d.joint.imu_matrices);
   EXPECT_EQ(s.joint.priors.gyro_scale, d.joint.priors.gyro_scale);
   EXPECT_EQ(s.joint.priors.gyro_cross_axis, d.joint.priors.gyro_cross_axis);
   EXPECT_EQ(s.joint.priors.gyro_bias_walk_rad_s_sqrt_s, d.joint.priors.gyro_bias_walk_rad_s_sqrt_s);
@@ -195,6 +197,7 @@ TEST(PipelineConfig, BadFilesAreRefusedNamingTheKey) {
   expectRefused("stationary_window: 1.0\n", "unknown key 'stationary_window'");
   expectRefused("solver_method: best\n", "solver_method");
   expectRefused("imu_orientation: compass\n", "imu_orientation");
+  expectRefused("imu_matrices: guess\n", "'select', 'estimate' or 'identity'");
   expectRefused("mag_hard_iron_t: [1, 2]\n", "mag_hard_iron_t");
   expectRefused("mag_soft_iron: [0, 0, 0, 0, 0, 0, 0, 0, 0]\n", "soft_iron");
   expectRefused("accel_weight: 1.5\n", "accel_weight");

@@ -90,9 +90,26 @@ enum class AccelMatrixForm {
   kSymmetric         ///< symmetric (polar decomposition without its rotation)
 };
 
+/// What is done with the gyro and accelerometer matrices T_g and T_a.
+enum class ImuMatrixModel {
+  kEstimate,  ///< estimated, held by their priors (ImuModelPriors)
+  kIdentity,  ///< held at I without uncertainty: a unit whose scale and axes are calibrated
+  /// Both solved; T = I kept unless the likelihood ratio rejects it (chi2 of the identity model
+  /// minus the estimated one's, chi-square with as many degrees of freedom as free entries of T,
+  /// p below model_selection_level): the data's own evidence for scale and misalignment errors.
+  kSelect
+};
+
+/// 'select', 'estimate', 'identity' (the configuration's words).
+const char* toString(ImuMatrixModel model);
+/// False (model unchanged) for an unknown word.
+bool parseImuMatrixModel(const std::string& text, ImuMatrixModel* model);
+
 struct JointSettings {
   ImuModelPriors priors;
   AccelMatrixForm accel_matrix_form = AccelMatrixForm::kLowerTriangular;
+  ImuMatrixModel imu_matrices = ImuMatrixModel::kSelect;
+  double model_selection_level = 0.01;  ///< for ImuMatrixModel::kSelect, in (0, 1)
   /// Robust loss on the camera, accelerometer, magnetometer and gyro residual blocks; the scale is
   /// in sigma units of the whitened block (|r| below it is unaffected by Huber).
   RobustLossKind robust_loss = RobustLossKind::kHuber;
@@ -196,6 +213,8 @@ struct JointResult {
   std::vector<double> pose_residual_norm;
   int iterations = 0;        ///< Levenberg-Marquardt iterations over all passes
   int relinearisations = 0;  ///< gyro preintegration passes
+  /// The model of T_g and T_a this result is of: kEstimate or kIdentity (kSelect chooses one).
+  ImuMatrixModel imu_matrices = ImuMatrixModel::kEstimate;
   double solve_time_s = 0;
   std::vector<std::string> notes;  ///< what was not estimated and why, what to rotate about
   /// Unit vector (IMU frame): the rotation axis that would add the most information.

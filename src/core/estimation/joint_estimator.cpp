@@ -4,10 +4,12 @@
 #include <ceres/solver.h>
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <string>
 #include <utility>
 
 #include "camera_imu_alignment/estimation/gyro_preintegration.h"
@@ -88,12 +90,9 @@ std::string summary(const JointProblem& problem, const JointResult& result) {
   return buffer;
 }
 
-}  // namespace
-
-JointEstimator::JointEstimator(JointSettings settings) : settings_(std::move(settings)) {}
-
-JointResult JointEstimator::solve(const JointProblem& problem,
-                                  const Eigen::Matrix3d& R_cam_imu_initial) const {
+/// One solve with the matrices' model of `settings` (kEstimate or kIdentity).
+JointResult solveModel(const JointProblem& problem, const Eigen::Matrix3d& R_cam_imu_initial,
+                       const JointSettings& settings) {
   const auto start = std::chrono::steady_clock::now();
   JointResult result;
   const auto finish = [&](JointResult& r) -> JointResult {
@@ -106,7 +105,7 @@ JointResult JointEstimator::solve(const JointProblem& problem,
     }
     return r;
   };
-  result.message = joint::validateProblem(problem, R_cam_imu_initial, settings_);
+  result.message = joint::validateProblem(problem, R_cam_imu_initial, settings);
   if (!result.message.empty()) return finish(result);
 
   // Preintegrate with the ideal gyro and the rests' biases; decide what the motion excites.
@@ -118,17 +117,17 @@ JointResult JointEstimator::solve(const JointProblem& problem,
   // The gyro's excitation is judged again after the first pass, from the gyro corrected by the
   // estimated T_g (the raw gyro's cross-axis terms leak ~1 % of every rotation into other axes);
   // until then no gyro column is pinned.
-  JointObservability observability = decideObservability(problem, excitationOf(gyro), settings_);
+  JointObservability observability = decideObservability(problem, excitationOf(gyro), settings);
   observability.gyro_column_estimated = {true, true, true};
-  joint::State state = joint::initialState(problem, R_cam_imu_initial, observability, settings_);
+  joint::State state = joint::initialState(problem, R_cam_imu_initial, observability, settings);
   joint::Whitening whitening;
-  if (!joint::computeWhitening(problem, gyro, settings_, &whitening, &result.message)) {
+  if (!joint::computeWhitening(problem, gyro, settings, &whitening, &result.message)) {
     return finish(result);
   }
 
-  const ceres::Solver::Options options = solverOptions(settings_);
+  const ceres::Solver::Options options = solverOptions(settings);
   bool converged = false, gyro_settled = true;
-  for (int pass = 0; pass < settings_.max_relinearisations; ++pass) {
+  for (int pass = 0; pass < settings.max_relinearisations; ++pass) {
     if (pass > 0) {
       const Eigen::Matrix3d T_g = state.gyroMatrix();
       if (!T_g.allFinite() || !(std::abs(T_g.determinant()) > 0.5)) {
@@ -138,13 +137,13 @@ JointResult JointEstimator::solve(const JointProblem& problem,
       for (size_t k = 0; k < n; ++k) biases[k] = state.gyroBias(static_cast<int>(k));
       gyro = preintegrateAll(problem, T_g, biases);
       if (pass == 1) {
-        observability = decideObservability(problem, excitationOf(gyro), settings_);
-        if (settings_.pin_unexcited_parameters) state.holdUnexcitedGyroColumns(observability);
+        observability = decideObservability(problem, excitationOf(gyro), settings);
+        if (settings.pin_unexcited_parameters) state.holdUnexcitedGyroColumns(observability);
       }
     }
     ceres::Problem ceres_problem;
     const joint::BuiltProblem built = joint::buildProblem(problem, gyro, whitening, observability,
-                                                          settings_, &state, &ceres_problem);
+                                                          settings, &state, &ceres_problem);
     ceres::Solver::Summary solver_summary;
     ceres::Solve(options, &ceres_problem, &solver_summary);
     result.iterations += static_cast<int>(solver_summary.iterations.size());
@@ -157,9 +156,9 @@ JointResult JointEstimator::solve(const JointProblem& problem,
     // With gyro segments at least two passes: the second one judges the gyro's excitation.
     const bool judged = problem.segments.empty() || pass >= 1;
     gyro_settled = gyroModelChange(problem, state, gyro) < kRelinearisationThreshold;
-    const bool last = pass + 1 == settings_.max_relinearisations || (judged && gyro_settled);
+    const bool last = pass + 1 == settings.max_relinearisations || (judged && gyro_settled);
     if (last) {
-      if (!joint::fillResult(problem, state, built, observability, settings_, &ceres_problem,
+      if (!joint::fillResult(problem, state, built, observability, settings, &ceres_problem,
                              &result)) {
         return finish(result);
       }
@@ -178,23 +177,23 @@ JointResult JointEstimator::solve(const JointProblem& problem,
   }
   result.suggested_rotation_axis_imu = observability.suggested_rotation_axis_imu;
   result.notes = observability.notes;
-  if (!(result.std_dev_deg.maxCoeff() <= settings_.max_std_dev_deg)) {
+  if (!(result.std_dev_deg.maxCoeff() <= settings.max_std_dev_deg)) {
     char buffer[256];
     std::snprintf(buffer, sizeof(buffer),
                   "R_cam_imu is not determined: 1-sigma [%.2f %.2f %.2f] deg > %.2f deg (the "
                   "poses barely rotate)",
                   result.std_dev_deg(0), result.std_dev_deg(1), result.std_dev_deg(2),
-                  settings_.max_std_dev_deg);
+                  settings.max_std_dev_deg);
     result.message = buffer;
     return finish(result);
   }
   if (!converged) {
     result.notes.push_back("the solver stopped before converging (max_iterations " +
-                           std::to_string(settings_.max_iterations) + ")");
+                           std::to_string(settings.max_iterations) + ")");
   }
   if (!gyro_settled) {
     result.notes.push_back("the gyro model still moved in the last of " +
-                           std::to_string(settings_.max_relinearisations) +
+                           std::to_string(settings.max_relinearisations) +
                            " preintegration passes (max_relinearisations)");
   }
   if (result.covariance_scale > 1.0) {
@@ -205,8 +204,127 @@ JointResult JointEstimator::solve(const JointProblem& problem,
     result.notes.push_back(buffer);
   }
   result.ok = true;
+  result.imu_matrices = settings.imu_matrices;
   result.message = summary(problem, result);
   return finish(result);
+}
+
+/// Free entries of T_g and T_a in the estimated model (the likelihood ratio's degrees of freedom).
+int freeMatrixEntries(const JointProblem& problem, const JointResult& estimated,
+                      const JointSettings& settings) {
+  const ImuIntrinsics& in = estimated.intrinsics;
+  const bool pin = settings.pin_unexcited_parameters;
+  int count = 0;
+  for (int c = 0; c < 3; ++c) {
+    if (!problem.segments.empty() && (in.gyro_matrix_column_estimated[c] || !pin)) count += 3;
+  }
+  if (in.accel_matrix_estimated || !pin) count += 6;
+  return count;
+}
+
+/// Largest |entry of T - I| / its 1-sigma over the entries the estimated model freed.
+double largestMatrixDeviation(const JointResult& estimated) {
+  const ImuIntrinsics& in = estimated.intrinsics;
+  double largest = 0.0;
+  auto consider = [&](const Eigen::Matrix3d& T, const Eigen::Matrix3d& sigma) {
+    const Eigen::Matrix3d deviation = T - Eigen::Matrix3d::Identity();
+    for (int i = 0; i < 9; ++i) {
+      if (sigma(i) > 0.0) largest = std::max(largest, std::abs(deviation(i)) / sigma(i));
+    }
+  };
+  consider(in.gyro_matrix, in.gyro_matrix_sigma);
+  consider(in.accel_matrix, in.accel_matrix_sigma);
+  return largest;
+}
+
+std::string likelihoodRatioNote(double ratio, int dof, double p, const char* decision) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer),
+                "T_g and T_a %s: likelihood ratio against holding them at identity chi2 %.1f on "
+                "%d dof, p %.3g",
+                decision, ratio, dof, p);
+  return buffer;
+}
+
+/// ImuMatrixModel::kSelect: the estimated model, and the identity model unless the estimate alone
+/// already rejects it; the identity model is kept unless the likelihood ratio rejects it.
+JointResult selectModel(const JointProblem& problem, const Eigen::Matrix3d& R_cam_imu_initial,
+                        const JointSettings& settings) {
+  JointSettings estimate_settings = settings, identity_settings = settings;
+  estimate_settings.imu_matrices = ImuMatrixModel::kEstimate;
+  identity_settings.imu_matrices = ImuMatrixModel::kIdentity;
+  JointResult estimated = solveModel(problem, R_cam_imu_initial, estimate_settings);
+  const int dof = estimated.ok ? freeMatrixEntries(problem, estimated, settings) : 0;
+  if (estimated.ok && dof > 0) {
+    // Linearised, the likelihood ratio is at least the square of any one entry's deviation in
+    // sigma units; far beyond the level (1e-3 of it) the identity model need not be solved.
+    const double z = largestMatrixDeviation(estimated);
+    const double p_bound = joint::chiSquareUpperTail(z * z, dof);
+    if (p_bound < 1e-3 * settings.model_selection_level) {
+      char buffer[160];
+      std::snprintf(buffer, sizeof(buffer),
+                    "T_g and T_a estimated: an entry is %.1f sigma from identity (likelihood ratio "
+                    "against identity p < %.3g)",
+                    z, p_bound);
+      estimated.notes.push_back(buffer);
+      return estimated;
+    }
+  }
+  JointResult identity = solveModel(problem, R_cam_imu_initial, identity_settings);
+  if (!identity.ok) return estimated;
+  if (!estimated.ok) {
+    identity.notes.push_back("T_g and T_a held at identity: estimating them failed (" +
+                             estimated.message + ")");
+    return identity;
+  }
+  const double ratio = std::max(0.0, identity.chi2 - estimated.chi2);
+  const double p = joint::chiSquareUpperTail(ratio, dof);
+  if (dof > 0 && p < settings.model_selection_level) {
+    estimated.notes.push_back(likelihoodRatioNote(ratio, dof, p, "estimated"));
+    return estimated;
+  }
+  identity.notes.push_back(
+      likelihoodRatioNote(ratio, dof, p, "held at identity (the data do not call for them)"));
+  return identity;
+}
+
+}  // namespace
+
+const char* toString(ImuMatrixModel model) {
+  switch (model) {
+    case ImuMatrixModel::kEstimate:
+      return "estimate";
+    case ImuMatrixModel::kIdentity:
+      return "identity";
+    case ImuMatrixModel::kSelect:
+      break;
+  }
+  return "select";
+}
+
+bool parseImuMatrixModel(const std::string& text, ImuMatrixModel* model) {
+  for (ImuMatrixModel m :
+       {ImuMatrixModel::kSelect, ImuMatrixModel::kEstimate, ImuMatrixModel::kIdentity}) {
+    if (text == toString(m)) {
+      *model = m;
+      return true;
+    }
+  }
+  return false;
+}
+
+JointEstimator::JointEstimator(JointSettings settings) : settings_(std::move(settings)) {}
+
+JointResult JointEstimator::solve(const JointProblem& problem,
+                                  const Eigen::Matrix3d& R_cam_imu_initial) const {
+  if (settings_.imu_matrices != ImuMatrixModel::kSelect) {
+    return solveModel(problem, R_cam_imu_initial, settings_);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  JointResult chosen = selectModel(problem, R_cam_imu_initial, settings_);
+  chosen.solve_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return chosen;
 }
 
 }  // namespace camera_imu_alignment

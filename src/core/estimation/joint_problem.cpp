@@ -50,7 +50,8 @@ class Builder {
         state_(*state),
         ceres_(*ceres_problem),
         loss_(makeLoss(settings)),
-        pin_(settings.pin_unexcited_parameters) {}
+        pin_(settings.pin_unexcited_parameters),
+        identity_matrices_(settings.imu_matrices == ImuMatrixModel::kIdentity) {}
 
   BuiltProblem build(const std::vector<GyroPreintegration>& gyro) {
     const size_t n = problem_.poses.size();
@@ -118,7 +119,9 @@ class Builder {
              -1, 3);
     }
     const ImuModelPriors& p = settings_.priors;
-    if (observability_.accel_matrix_estimated || !pin_) {
+    if (identity_matrices_) {
+      holdBlock(state_.accel_matrix.data());
+    } else if (observability_.accel_matrix_estimated || !pin_) {
       record(ceres_.AddResidualBlock(
                  maskedPrior(6, {0, 1, 2, 3, 4, 5},
                              {p.accel_scale, p.accel_scale, p.accel_scale, p.accel_cross_axis,
@@ -234,6 +237,10 @@ class Builder {
                                   state_.gyro_bias[from].data(), state_.gyro_bias[to].data()),
           from, to, 3);
     }
+    if (identity_matrices_) {
+      holdBlock(state_.gyro_matrix.data());
+      return;
+    }
     // Priors on the columns of T_g - I; with pin_, the columns not excited are held instead.
     std::vector<int> free_entries, held_entries;
     std::vector<double> sigmas;
@@ -266,7 +273,8 @@ class Builder {
   State& state_;
   ceres::Problem& ceres_;
   ceres::LossFunction* loss_;
-  const bool pin_;  // hold what is not excited constant (else it keeps its prior)
+  const bool pin_;                // hold what is not excited constant (else it keeps its prior)
+  const bool identity_matrices_;  // T_g and T_a held at I (ImuMatrixModel::kIdentity)
   BuiltProblem built_;
 };
 

@@ -178,12 +178,15 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
       p.soft_iron_cross, p.soft_iron_cross;
   for (int i = 0; i < 9; ++i) gyro_prior(i) = i % 4 == 0 ? p.gyro_scale : p.gyro_cross_axis;
 
-  const Eigen::VectorXd accel_sigma =
+  // T_g and T_a held at I (ImuMatrixModel::kIdentity) have no uncertainty.
+  const bool identity = settings.imu_matrices == ImuMatrixModel::kIdentity;
+  Eigen::VectorXd accel_sigma =
       blockSigma(*used, requested, state.accel_matrix.data(), accel_prior, scale);
+  if (identity) accel_sigma.setZero();
   in.accel_matrix =
       Eigen::Matrix3d::Identity() + sixToMatrix(toVector(state.accel_matrix.data(), 6), symmetric);
   in.accel_matrix_sigma = sixToMatrix(accel_sigma, symmetric);
-  in.accel_matrix_estimated = observability.accel_matrix_estimated;
+  in.accel_matrix_estimated = observability.accel_matrix_estimated && !identity;
   const Eigen::VectorXd accel_bias_sigma =
       blockSigma(*used, requested, state.accel_bias[0].data(),
                  Eigen::Vector3d::Constant(p.accel_bias_m_s2), scale);
@@ -199,10 +202,12 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
   Eigen::VectorXd gyro_sigma =
       blockSigma(*used, requested, state.gyro_matrix.data(), gyro_prior, scale);
   for (int c = 0; c < 3; ++c) {
-    in.gyro_matrix_column_estimated[c] = has_gyro && observability.gyro_column_estimated[c];
+    in.gyro_matrix_column_estimated[c] =
+        has_gyro && observability.gyro_column_estimated[c] && !identity;
     for (int r = 0; r < 3; ++r) {
       const bool held = !in.gyro_matrix_column_estimated[c] && settings.pin_unexcited_parameters;
       if (held || !has_gyro) gyro_sigma(3 * r + c) = gyro_prior(3 * r + c);
+      if (identity) gyro_sigma(3 * r + c) = 0.0;
     }
   }
   in.gyro_matrix = state.gyroMatrix();

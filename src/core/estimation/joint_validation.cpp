@@ -42,6 +42,9 @@ std::string validateSettings(const JointSettings& s) {
   if (!finitePositive(s.gravity_m_s2)) return "settings: gravity_m_s2 must be finite and > 0";
   if (!finitePositive(s.robust_loss_scale)) return "settings: robust_loss_scale must be > 0";
   if (!finitePositive(s.max_std_dev_deg)) return "settings: max_std_dev_deg must be > 0";
+  if (!(s.model_selection_level > 0.0 && s.model_selection_level < 1.0)) {
+    return "settings: model_selection_level must be within (0, 1)";
+  }
   if (s.max_iterations < 1 || s.max_relinearisations < 2) {
     return "settings: max_iterations must be >= 1 and max_relinearisations >= 2";
   }

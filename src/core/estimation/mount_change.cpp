@@ -62,7 +62,11 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
     return test;
   }
   test.tested = true;
-  const JointEstimator estimator(joint_settings);
+  // The two-mount model differs from the one-mount model by the second rotation alone: the same
+  // model of T_g and T_a (no second model selection, whose choice could move the chi-square).
+  JointSettings two_mount_settings = joint_settings;
+  two_mount_settings.imu_matrices = one_mount.imu_matrices;
+  const JointEstimator estimator(two_mount_settings);
   int best = -1;
   for (int s = first; s <= last; ++s) {
     JointProblem split = problem;

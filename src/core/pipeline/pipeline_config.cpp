@@ -74,6 +74,13 @@ const std::vector<Key>& keys() {
        "'joint', 'auto', 'magnetometer' or 'message'"},
       number<double>(
           "accel_weight", [](auto* s) { return &s->accel_weight; }, "a number within (0, 1)"),
+      {"imu_matrices",
+       [](const YAML::Node& node, PipelineSettings* s) {
+         if (!parseImuMatrixModel(node.as<std::string>(), &s->joint.imu_matrices)) {
+           throw YAML::Exception(node.Mark(), "unknown model");
+         }
+       },
+       "'select', 'estimate' or 'identity'"},
       // Joint estimate: 1-sigma of the priors on the IMU's errors.
       number<double>(
           "imu_prior_gyro_scale", [](auto* s) { return &s->joint.priors.gyro_scale; }, kPositive),
