@@ -4,6 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <opencv2/imgcodecs.hpp>
@@ -121,6 +122,23 @@ TEST(CalibrateBag, ImuGradesWithTheDefaultPriors) {
   const Calibration c = calibrate(consumer);
   expectAccurate(c, 0.2, "consumer");
   EXPECT_TRUE(c.consistent) << c.run.out;
+  // The accelerometer bias walks: one per pose in the result, the first pose's as before, within 3
+  // sigma of the truth at the start (measured 0.0071, 0.0016, 0.0053 m/s^2 off, 1-sigma
+  // 0.006-0.01).
+  const YAML::Node result = YAML::LoadFile(temp("result.yaml"));
+  const YAML::Node bias = result["imu_intrinsics"]["accel_bias_m_s2"];
+  const YAML::Node per_pose = result["imu_intrinsics"]["accel_bias_per_pose_m_s2"];
+  ASSERT_TRUE(per_pose && per_pose.IsSequence()) << test::readTextFile(temp("result.yaml"));
+  EXPECT_EQ(per_pose.size(), result["quality"]["num_poses"].as<std::size_t>());
+  const auto first = bias["value"].as<std::vector<double>>();
+  const auto sigma = bias["sigma"].as<std::vector<double>>();
+  EXPECT_EQ(per_pose[0].as<std::vector<double>>(), first);
+  const auto truth =
+      YAML::LoadFile(stem(consumer) + ".truth.yaml")["imu"]["accelerometer_bias_initial"]
+          .as<std::vector<double>>();
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_LT(std::abs(first[axis] - truth[axis]), 3.0 * sigma[axis]) << "axis " << axis;
+  }
   removeBag(consumer);
   const std::string noisy = simulate("noisy", "--scenario noisy_consumer --seed 55");
   const Calibration n = calibrate(noisy);
