@@ -418,6 +418,13 @@ TEST_F(AlignmentRos, ManualCaptureTakesOnlyTheArmedRest) {
   const ExtraNode deaf(
       "deaf", "_load_on_start:=false" + remapsUnder("manual") + " imu/data_raw:=/deaf/wrong_imu");
   ASSERT_TRUE(deaf.started()) << deaf.log();
+  // And one told of the wrong target (an AprilGrid while the bag shows a checkerboard).
+  const std::string wrong_target = temp("wrong_target.yaml");
+  std::ofstream(wrong_target) << "target_type: aprilgrid\ntagCols: 6\ntagRows: 6\n"
+                                 "tagSize: 0.088\ntagSpacing: 0.3\n";
+  const ExtraNode blind(
+      "blind", "_load_on_start:=false _target_file:=" + wrong_target + remapsUnder("manual"));
+  ASSERT_TRUE(blind.started()) << blind.log();
   EXPECT_EQ(play(bag, 3.0, remapsUnder("manual")).get(), 0);
   // All rests but the last are judged while the bag plays (the last one, unarmed, would not count
   // either); the status is latched.
@@ -432,6 +439,14 @@ TEST_F(AlignmentRos, ManualCaptureTakesOnlyTheArmedRest) {
   EXPECT_NE(deaf.log().find("nothing on /deaf/wrong_imu"), std::string::npos) << deaf.log();
   ASSERT_TRUE(deaf_diagnostics.count("level"));
   EXPECT_EQ(deaf_diagnostics.at("level"), "1") << deaf_diagnostics.at("summary");  // WARN
+  // The wrong target: never found, said in diagnostics (WARN).
+  const auto blind_diagnostics = waitForDiagnostics("blind", 20.0, [](const auto& v) {
+    return v.count("summary") && v.at("summary").find("target was not found") != std::string::npos;
+  });
+  ASSERT_TRUE(blind_diagnostics.count("summary")) << blind.log();
+  EXPECT_NE(blind_diagnostics.at("summary").find("target was not found"), std::string::npos)
+      << blind_diagnostics.at("summary");
+  EXPECT_EQ(blind_diagnostics.at("level"), "1");
   // The later rests were not armed: said so, not "no camera data".
   EXPECT_NE(manual.log().find("not used: not armed"), std::string::npos) << manual.log();
   EXPECT_EQ(manual.log().find("no camera data"), std::string::npos) << manual.log();

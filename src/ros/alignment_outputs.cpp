@@ -341,7 +341,7 @@ void AlignmentWrapper::Impl::diagnose(diagnostic_updater::DiagnosticStatusWrappe
     problems.push_back("nothing on " + topicOf(stream) + " while other inputs flow");
   }
   const std::uint64_t not_found = pipeline.rejections().count(RejectReason::kTargetNotFound);
-  if (pipeline.framesDetected() >= 20 && not_found >= pipeline.framesDetected()) {
+  if (pipeline.framesDetected() >= 10 && not_found >= pipeline.framesDetected()) {
     problems.push_back("the target was not found in any of " +
                        std::to_string(pipeline.framesDetected()) +
                        " frames at rest: does target_file describe the board in view?");

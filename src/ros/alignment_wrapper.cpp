@@ -137,8 +137,9 @@ void AlignmentWrapper::Impl::warnSilentStreams() {
   if (!mag_absence_noted && !streams.everSeen(InputStream::kMagnetometer) &&
       calibrator->pipeline().imuSamples() > 2000) {
     mag_absence_noted = true;
-    ROS_INFO(
-        "%s: nothing on %s: the magnetometer is not used (fine for a 6-axis IMU; remap "
+    ROS_WARN(
+        "%s: nothing on %s while the IMU flows: the magnetometer is not used (fine for a 6-axis "
+        "IMU; remap "
         "imu/mag if yours has one)",
         name.c_str(), mag_sub.getTopic().c_str());
   }
