@@ -111,8 +111,9 @@ TEST(CalibrateBag, ImuGradesWithTheDefaultPriors) {
   // consumer unit's priors). Measured (2026-11-24): tactical seed 51 0.015 deg (|z| <= 0.42),
   // consumer seeds 52 and 56 0.043 and 0.066 deg (|z| <= 1.16), all consistent; the noisy grade's
   // errors exceed the consumer priors 3x: seeds 53-55 0.08-0.40 deg within 3 sigma scaled by
-  // chi2/dof (2.2-2.5), every one flagged inconsistent (p < 1e-6). Bounds: the ideal grade's
-  // 0.1 deg for tactical, the target 0.2 deg for consumer, 1 deg for noisy (2.5x the worst seed).
+  // chi2/dof (2.2-2.5), every one flagged inconsistent (p < 1e-6: exit 4). Bounds: the ideal
+  // grade's 0.1 deg for tactical, the target 0.2 deg for consumer, 1 deg for noisy (2.5x the worst
+  // seed).
   const std::string tactical = simulate("tactical", "--scenario tactical --seed 51");
   const Calibration t = calibrate(tactical);
   expectAccurate(t, 0.1, "tactical");
@@ -141,9 +142,18 @@ TEST(CalibrateBag, ImuGradesWithTheDefaultPriors) {
   }
   removeBag(consumer);
   const std::string noisy = simulate("noisy", "--scenario noisy_consumer --seed 55");
-  const Calibration n = calibrate(noisy);
-  expectAccurate(n, 1.0, "noisy, consumer priors");
-  EXPECT_FALSE(n.consistent) << n.run.out;
+  const Calibration n = calibrate(noisy, "--truth " + stem(noisy) + ".truth.yaml");
+  // Flagged: the nodelet's gates refuse an inconsistent estimate, so calibrate_bag exits 4 and
+  // writes nothing, saying which gate ...
+  EXPECT_EQ(n.run.exit_code, 4) << n.run.err << n.run.out;
+  EXPECT_NE(n.run.out.find("verdict: FAILED: the data do not fit one mount"), std::string::npos)
+      << n.run.out;
+  EXPECT_NE(n.run.out.find("INCONSISTENT"), std::string::npos) << n.run.out;
+  EXPECT_FALSE(std::filesystem::exists(temp("result.yaml")));
+  // ... while the estimate it prints is still within 1 deg of the truth.
+  const auto at = n.run.out.find("error to ");
+  ASSERT_NE(at, std::string::npos) << n.run.out;
+  EXPECT_LT(std::stod(n.run.out.substr(n.run.out.find(": ", at) + 2)), 1.0) << n.run.out;
   // With the unit's own priors (test/data/noisy_imu.yaml) the same bag is consistent: measured
   // seeds 53-55 0.13-0.58 deg, |z| <= 2.15, p 0.06-0.81 (seed 55: 0.13 deg).
   const Calibration own = calibrate(noisy, "--config " TEST_DATA_DIR "/noisy_imu.yaml");
