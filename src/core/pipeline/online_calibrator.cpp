@@ -54,7 +54,7 @@ std::string OnlineSettings::validate() const {
 
 struct OnlineCalibrator::Impl {
   Impl(const TargetDescription& target, const PipelineSettings& pipeline_settings,
-       const OnlineSettings& online, OnlineCallbacks cb, OnlineCalibrator* owner);
+       const OnlineSettings& online, OnlineCallbacks cb);
 
   PipelineSettings pipeline_settings;
   OnlineSettings settings;
@@ -89,7 +89,8 @@ struct OnlineCalibrator::Impl {
       setState(CalibrationState::kCollecting, "waiting for stationary poses");
     }
   }
-  bool checkClock(double stamp_s, InputStream stream);
+  /// A stamp far behind the input's newest (a bag loop): window and buffers cleared.
+  void checkClock(double stamp_s, InputStream stream);
   void onPose(const StationaryPose& pose);
   void onPoseRejected(const RejectedPose& rejected);
   void checkPairRemount(const StationaryPose& pose);
@@ -99,14 +100,15 @@ struct OnlineCalibrator::Impl {
   void applyRemount(const SolveOutput& output);
   /// Keeps the window's poses from `first_index` on and says so (state, on_remount).
   void restartWindowAt(int first_index, double change_deg, const std::string& text);
+  /// The output as an estimate judged by the gates against what is broadcast now.
+  EstimateEvent judged(SolveOutput output) const;
   void applyEstimate(EstimateEvent event);
   void doBroadcast(const AlignmentResult& result, std::size_t poses);
 };
 
 OnlineCalibrator::Impl::Impl(const TargetDescription& target,
                              const PipelineSettings& pipeline_settings_in,
-                             const OnlineSettings& online, OnlineCallbacks cb,
-                             OnlineCalibrator* /*owner*/)
+                             const OnlineSettings& online, OnlineCallbacks cb)
     : pipeline_settings(pipeline_settings_in), settings(online), callbacks(std::move(cb)) {
   const std::string error = settings.validate();
   if (!error.empty()) throw std::invalid_argument(error);
@@ -121,15 +123,14 @@ OnlineCalibrator::Impl::Impl(const TargetDescription& target,
   if (settings.threaded) worker = std::make_unique<SolveWorker>(pipeline_settings, settings);
 }
 
-bool OnlineCalibrator::Impl::checkClock(double stamp_s, InputStream stream) {
+void OnlineCalibrator::Impl::checkClock(double stamp_s, InputStream stream) {
   const double jump_s = clock.update(toString(stream), stamp_s);
-  if (jump_s <= 0.0) return false;
+  if (jump_s <= 0.0) return;
   pipeline->reset();
   ++generation;
   inconsistent_poses = 0;
   last_pose.reset();
   if (callbacks.on_clock_jump) callbacks.on_clock_jump(jump_s, stream);
-  return true;
 }
 
 void OnlineCalibrator::Impl::onPose(const StationaryPose& pose) {
@@ -215,12 +216,16 @@ void OnlineCalibrator::Impl::apply(SolveOutput output) {
     applyRemount(output);
     return;
   }
+  applyEstimate(judged(std::move(output)));
+}
+
+EstimateEvent OnlineCalibrator::Impl::judged(SolveOutput output) const {
   EstimateEvent event;
   event.result = std::move(output.result);
   event.window_poses = output.window.pose_indices.size();
   event.mount_test = std::move(output.mount_test);
   event.gate = judgeEstimate(event.result, event.window_poses, settings, broadcast, fresh_start);
-  applyEstimate(std::move(event));
+  return event;
 }
 
 void OnlineCalibrator::Impl::applyRemount(const SolveOutput& output) {
@@ -280,8 +285,7 @@ void OnlineCalibrator::Impl::doBroadcast(const AlignmentResult& result, std::siz
 OnlineCalibrator::OnlineCalibrator(const TargetDescription& target,
                                    const PipelineSettings& pipeline_settings,
                                    const OnlineSettings& settings, OnlineCallbacks callbacks)
-    : impl_(std::make_unique<Impl>(target, pipeline_settings, settings, std::move(callbacks),
-                                   this)) {}
+    : impl_(std::make_unique<Impl>(target, pipeline_settings, settings, std::move(callbacks))) {}
 
 OnlineCalibrator::~OnlineCalibrator() = default;
 
@@ -347,11 +351,7 @@ CalibrateOutcome OnlineCalibrator::calibrateNow(bool force) {
     out.not_broadcast_reason = output.result.message;
     return out;
   }
-  EstimateEvent event;
-  event.result = output.result;
-  event.window_poses = poses;
-  event.gate =
-      judgeEstimate(event.result, poses, impl_->settings, impl_->broadcast, impl_->fresh_start);
+  EstimateEvent event = impl_->judged(std::move(output));
   out.gate = event.gate;
   const bool forcible = force && event.gate.decision != GateDecision::kBroadcast &&
                         event.result.status == SolveStatus::kOk &&
