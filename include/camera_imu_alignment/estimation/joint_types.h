@@ -35,6 +35,11 @@ struct JointPose {
   Eigen::Matrix3d gyro_mean_cov = Eigen::Matrix3d::Zero();    ///< (rad/s)^2, of that mean
   std::optional<Eigen::Vector3d> mag_mean_t;  ///< tesla, IMU frame; empty when unusable
   Eigen::Matrix3d mag_mean_cov = Eigen::Matrix3d::Zero();  ///< T^2, of that mean
+  /// The field was flagged by a check on the raw field (its norm or dip against the other rests',
+  /// inertial/magnetometer.h), which cannot tell a disturbance from uncalibrated iron (15 uT of
+  /// hard iron changes the norm by a third with the orientation). The estimator tries such a
+  /// field with the iron calibrated and keeps it when it fits (JointEstimator: screening).
+  bool mag_flagged = false;
 };
 
 /// Raw gyro samples from the end of rest `from_pose` to the start of rest `to_pose`. Sample i holds
@@ -141,7 +146,7 @@ struct JointSettings {
   /// Hard iron: at least this many poses with a usable field and its coverage; soft iron: its
   /// spread (like the accelerometer's bias and matrix).
   int min_mag_poses_hard_iron = 4;
-  double min_mag_coverage_hard_iron = 0.15;
+  double min_mag_coverage_hard_iron = 0.1;
   int min_mag_poses_soft_iron = 7;
   double min_mag_spread_soft_iron = 0.1;
 
@@ -211,6 +216,11 @@ struct JointResult {
   /// Per pose: RMS whitened residual (sigma units) over its camera, accelerometer, magnetometer and
   /// gyro-bias residuals and half of each adjacent gyro residual.
   std::vector<double> pose_residual_norm;
+  /// Per pose: the magnetometer residual's squared whitened norm (chi-square with 3 dof when the
+  /// model holds; robust loss not applied), 0 where the field is not used.
+  std::vector<double> mag_residual_chi2;
+  /// Poses whose field was left out as disturbed: it did not fit the calibrated iron and field.
+  std::vector<int> mag_poses_left_out;
   int iterations = 0;        ///< Levenberg-Marquardt iterations over all passes
   int relinearisations = 0;  ///< gyro preintegration passes
   /// The model of T_g and T_a this result is of: kEstimate or kIdentity (kSelect chooses one).

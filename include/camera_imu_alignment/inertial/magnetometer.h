@@ -15,8 +15,11 @@ enum class FieldUnits {
   kOutOfRange,           ///< anything else (zero, disturbed, other unit)
 };
 
-/// Classifies a field norm (in the message's unit, nominally tesla).
-FieldUnits classifyFieldUnits(double norm, double min_t = 15e-6, double max_t = 100e-6);
+/// Classifies a field norm (in the message's unit, nominally tesla). The range is that of a raw,
+/// uncalibrated reading: the earth's 25-65 microtesla plus hard iron of up to tens of microtesla
+/// either way (a 40 uT hard iron takes the norm down to a few uT at some orientations); gauss or
+/// microtesla read as tesla are still two decades outside it.
+FieldUnits classifyFieldUnits(double norm, double min_t = 1e-6, double max_t = 1e-3);
 /// Message for a unit problem: "field norm 0.45 looks like gauss; sensor_msgs/MagneticField is in
 /// tesla (set mag_scale ...)". The caller names the topic.
 std::string describeFieldUnits(FieldUnits units, double norm);

@@ -17,7 +17,9 @@
 //     (gyro and accelerometer matrices and biases, hard and soft iron) estimated where the poses
 //     excite them. Each measurement is weighted by its noise as measured on the recording (the
 //     rest's own scatter). It starts from the pair solve below (kAuto's poses).
-//   The other modes solve relative-rotation pairs of the poses with the IMU orientation below.
+//   kMagnetometer: the same estimate without the gyro (the paper's sensors: camera, gravity and
+//     field, the accelerometer's errors and the iron calibrated); it starts from its own pairs.
+//   kAuto and kMessage solve relative-rotation pairs of the poses with the IMU orientation below.
 // IMU orientation of a pose for the pairs:
 //   kAuto (default): the gyro, integrated bias-corrected from the previous pose (bias: mean of the
 //     two segments' gyro means), chained onto the previous pose's R_world_imu. The chain is
@@ -27,8 +29,8 @@
 //     the poses get a new group and pairs are formed only within a group. When the magnetometer is
 //     usable at both poses, the gyro and the accelerometer+magnetometer relative rotations are
 //     compared and the difference is reported (gyro_mag_difference_deg).
-//   kMagnetometer (the paper's): accelerometer + magnetometer at every pose where the field is
-//     usable, the gyro chain otherwise.
+//   kMagnetometer (the paper's): accelerometer + magnetometer (raw: no iron or bias corrected) at
+//     every pose where the field is usable, the gyro chain otherwise.
 //   kMessage: the IMU's own orientation estimate (sensor_msgs/Imu orientation, e.g. an AHRS with
 //     an onboard filter), averaged over the rest, at every pose where at least 5 samples carry one;
 //     the gyro chain otherwise. Its world frame is the sensor's: one group.
@@ -75,7 +77,7 @@ struct PipelineSettings {
   PoseSettings pose;
   SolverOptions solver;
   ImuOrientationSource imu_orientation = ImuOrientationSource::kJoint;
-  JointSettings joint;                 ///< the joint estimate (imu_orientation: joint)
+  JointSettings joint;                 ///< the joint estimate (imu_orientation: joint or magnetometer)
   std::size_t window_poses = 30;       ///< sliding window of stationary poses
   int min_poses_to_solve = 3;          ///< solve only with at least this many poses in the window
   int min_frames_per_pose = 2;         ///< camera frames with a pose needed for a stationary pose
@@ -141,11 +143,11 @@ struct RejectedPose {
 /// thread while samples keep arriving.
 struct WindowSnapshot {
   RotationPairs pairs;            ///< PoseWindow::makePairs
-  JointProblem joint;             ///< the joint estimator's problem (imu_orientation: joint)
+  JointProblem joint;             ///< the joint estimator's problem (imu_orientation: joint or magnetometer)
   std::vector<int> pose_indices;  ///< StationaryPose::index of each window pose, oldest first
 };
 
-/// The solve of CalibrationPipeline::solve(): the pair estimators, then (imu_orientation: joint)
+/// The solve of CalibrationPipeline::solve(): the pair estimators, then (imu_orientation: joint or magnetometer)
 /// the joint estimate started from the pair estimate. Pure: no pipeline state.
 AlignmentResult solveWindow(const WindowSnapshot& window, const PipelineSettings& settings);
 

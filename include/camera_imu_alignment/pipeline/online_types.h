@@ -33,7 +33,7 @@ struct OnlineSettings {
   /// refusing a correct estimate); a smaller p means the data do not fit one mount with the
   /// modelled noise.
   double consistency_level = 1e-3;
-  /// Pair modes only (imu_orientation other than joint, which has the chi-square test instead):
+  /// Pair modes only (imu_orientation auto or message; the joint modes have the chi-square test):
   /// the RMS pair residual (deg) a broadcast estimate may have.
   double max_residual_deg = 1.0;
   double min_change_deg = 0.01;  ///< re-broadcast only when the estimate moved more (deg)

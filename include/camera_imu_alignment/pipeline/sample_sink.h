@@ -28,6 +28,10 @@ struct CameraFrame {
 enum class ImuOrientationSource { kJoint, kAuto, kMagnetometer, kMessage };
 const char* toString(ImuOrientationSource source);
 bool parseImuOrientationSource(const std::string& text, ImuOrientationSource* source);
+/// The modes whose answer is a joint maximum-likelihood estimate (estimation/joint_estimator.h):
+/// kJoint (every sensor) and kMagnetometer (camera, accelerometer and magnetometer, the gyro left
+/// out). The others answer with the pair solve.
+bool usesJointEstimate(ImuOrientationSource source);
 
 class SampleSink {
  public:

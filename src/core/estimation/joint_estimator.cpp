@@ -288,6 +288,108 @@ JointResult selectModel(const JointProblem& problem, const Eigen::Matrix3d& R_ca
   return identity;
 }
 
+/// The matrices' model of the settings (kSelect: chosen by the likelihood ratio).
+JointResult solveMatrices(const JointProblem& problem, const Eigen::Matrix3d& R_cam_imu_initial,
+                          const JointSettings& settings) {
+  return settings.imu_matrices == ImuMatrixModel::kSelect
+             ? selectModel(problem, R_cam_imu_initial, settings)
+             : solveModel(problem, R_cam_imu_initial, settings);
+}
+
+/// Per-pose level of the magnetometer screening (Bonferroni over the poses with a field).
+constexpr double kMagOutlierLevel = 1e-3;
+/// The hard iron is calibrated by the poses when its posterior 1-sigma is below this fraction of
+/// its prior's on every axis.
+constexpr double kMaxHardIronSigmaOfPrior = 0.2;
+
+/// The pose whose field fits worst when it fails the per-pose chi-square test (3 dof), else -1.
+/// The residuals are scaled by their own median against chi-square(3)'s (2.366) when that is
+/// larger: robust to the outliers sought, and a unit whose field noise the rests understate does
+/// not lose every field.
+int worstMagnetometerPose(const JointResult& result) {
+  std::vector<double> used;
+  for (double chi2 : result.mag_residual_chi2) {
+    if (chi2 > 0.0) used.push_back(chi2);
+  }
+  if (used.empty()) return -1;
+  std::nth_element(used.begin(), used.begin() + used.size() / 2, used.end());
+  const double scale = std::max(1.0, used[used.size() / 2] / 2.366);
+  int worst = -1;
+  double worst_p = kMagOutlierLevel / static_cast<double>(used.size());
+  for (size_t k = 0; k < result.mag_residual_chi2.size(); ++k) {
+    const double chi2 = result.mag_residual_chi2[k];
+    if (!(chi2 > 0.0)) continue;
+    const double p = joint::chiSquareUpperTail(chi2 / scale, 3);
+    if (p < worst_p) {
+      worst_p = p;
+      worst = static_cast<int>(k);
+    }
+  }
+  return worst;
+}
+
+/// Fields flagged by the raw check (JointPose::mag_flagged) are tried with the iron estimated:
+/// the field that fits worst is left out while it fails its chi-square test, and the solve
+/// repeated. When the iron is then not determined by the poses (its posterior 1-sigma above
+/// kMaxHardIronSigmaOfPrior of the prior's) or a solve fails, the flagged fields are left out
+/// unseen, as the check said.
+JointResult screenMagnetometer(const JointProblem& problem,
+                               const Eigen::Matrix3d& R_cam_imu_initial,
+                               const JointSettings& settings) {
+  JointProblem unflagged = problem;
+  int flagged = 0;
+  for (JointPose& pose : unflagged.poses) {
+    if (pose.mag_flagged && pose.mag_mean_t) {
+      ++flagged;
+      pose.mag_mean_t.reset();
+    }
+    pose.mag_flagged = false;
+  }
+  if (flagged == 0 || settings.use_magnetometer == MagnetometerUse::kOff) {
+    return solveMatrices(unflagged, R_cam_imu_initial, settings);
+  }
+  // The raw field's directions understate how much the orientations vary (a hard iron of the
+  // earth field's size pulls them together), so the coverage rule is not applied here: the hard
+  // iron is estimated, and counts as calibrated when the data, not its prior, determine it.
+  JointSettings screen_settings = settings;
+  screen_settings.min_mag_coverage_hard_iron = 0.0;
+  JointProblem screened = problem;
+  std::vector<int> left_out;
+  for (int round = 0; round <= static_cast<int>(problem.poses.size()) / 2; ++round) {
+    JointResult result = solveMatrices(screened, R_cam_imu_initial, screen_settings);
+    if (!result.ok || !result.intrinsics.hard_iron_estimated) break;
+    const int worst = worstMagnetometerPose(result);
+    if (worst < 0) {
+      if (!(result.intrinsics.hard_iron_sigma_t.maxCoeff() <=
+            kMaxHardIronSigmaOfPrior * settings.priors.hard_iron_t)) {
+        break;  // the poses do not determine the iron: the raw check's verdict stands
+      }
+      result.mag_poses_left_out = left_out;
+      int flagged_used = 0;
+      for (const JointPose& pose : screened.poses)
+        flagged_used += pose.mag_flagged && pose.mag_mean_t;
+      char buffer[200];
+      std::snprintf(buffer, sizeof(buffer),
+                    "magnetometer: %d of %d rest(s) flagged by the raw field check used (they fit "
+                    "the calibrated iron); %zu rest(s) left out as disturbed",
+                    flagged_used, flagged, left_out.size());
+      result.notes.push_back(buffer);
+      for (int k : left_out) {
+        result.notes.push_back("magnetometer at pose " + std::to_string(k) +
+                               " left out: its field does not fit the calibrated iron (disturbed)");
+      }
+      return result;
+    }
+    screened.poses[worst].mag_mean_t.reset();
+    left_out.push_back(worst);
+  }
+  JointResult result = solveMatrices(unflagged, R_cam_imu_initial, settings);
+  result.notes.push_back("magnetometer: " + std::to_string(flagged) +
+                         " rest(s) flagged by the raw field check left out (the iron could not be "
+                         "calibrated with them)");
+  return result;
+}
+
 }  // namespace
 
 const char* toString(ImuMatrixModel model) {
@@ -317,11 +419,8 @@ JointEstimator::JointEstimator(JointSettings settings) : settings_(std::move(set
 
 JointResult JointEstimator::solve(const JointProblem& problem,
                                   const Eigen::Matrix3d& R_cam_imu_initial) const {
-  if (settings_.imu_matrices != ImuMatrixModel::kSelect) {
-    return solveModel(problem, R_cam_imu_initial, settings_);
-  }
   const auto start = std::chrono::steady_clock::now();
-  JointResult chosen = selectModel(problem, R_cam_imu_initial, settings_);
+  JointResult chosen = screenMagnetometer(problem, R_cam_imu_initial, settings_);
   chosen.solve_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return chosen;

@@ -82,8 +82,9 @@ class Builder {
         built_.free_blocks.end());
   }
 
-  void record(ceres::ResidualBlockId id, int pose, int other_pose, int size) {
-    built_.residuals.push_back({id, pose, other_pose, size});
+  void record(ceres::ResidualBlockId id, int pose, int other_pose, int size,
+              bool magnetometer = false) {
+    built_.residuals.push_back({id, pose, other_pose, size, magnetometer});
   }
 
   bool afterChange(size_t k) const {
@@ -167,7 +168,7 @@ class Builder {
       record(ceres_.AddResidualBlock(mag, loss_, state_.e_T.data(), cameraImuIncrement(k),
                                      state_.delta[k].data(), state_.soft_iron.data(),
                                      state_.hard_iron_ut.data(), state_.field_ut.data()),
-             static_cast<int>(k), -1, 3);
+             static_cast<int>(k), -1, 3, true);
     }
     const ImuModelPriors& p = settings_.priors;
     if (observability_.soft_iron_estimated || !pin_) {

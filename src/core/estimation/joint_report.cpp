@@ -96,12 +96,14 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
   double chi2 = 0.0;
   int residual_count = 0;
   Eigen::VectorXd r(16);
+  result->mag_residual_chi2.assign(n, 0.0);
   for (const ResidualRecord& record : built.residuals) {
     double cost = 0.0;
     r.resize(record.size);
     ceres_problem->EvaluateResidualBlock(record.id, false, &cost, r.data(), nullptr);
     const double squared = r.squaredNorm();
     chi2 += squared;
+    if (record.magnetometer && record.pose >= 0) result->mag_residual_chi2[record.pose] = squared;
     residual_count += record.size;
     if (record.pose < 0) continue;
     const double share = record.other_pose >= 0 ? 0.5 : 1.0;

@@ -57,6 +57,7 @@ struct ResidualRecord {
   ceres::ResidualBlockId id = nullptr;
   int pose = -1, other_pose = -1;  ///< -1 for priors; other_pose for gyro and walk residuals
   int size = 0;
+  bool magnetometer = false;  ///< the pose's magnetometer residual
 };
 
 /// The built problem's bookkeeping.

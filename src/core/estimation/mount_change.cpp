@@ -46,6 +46,21 @@ double worstPoseMisfit(std::vector<double> norms) {
   return worst / std::max(1.5, 2.5 * median);
 }
 
+/// The problem with the fields the one-mount estimate used and no others, none left to screen:
+/// both models are then compared on the same measurements.
+JointProblem withFieldsOf(const JointProblem& problem, const JointResult& one_mount) {
+  JointProblem out = problem;
+  const bool used = one_mount.intrinsics.magnetometer_used &&
+                    one_mount.mag_residual_chi2.size() == out.poses.size();
+  for (size_t k = 0; k < out.poses.size(); ++k) {
+    JointPose& pose = out.poses[k];
+    const bool keep = used ? one_mount.mag_residual_chi2[k] > 0.0 : !pose.mag_flagged;
+    if (!keep) pose.mag_mean_t.reset();
+    pose.mag_flagged = false;
+  }
+  return out;
+}
+
 }  // namespace
 
 MountChangeTest testMountChange(const JointProblem& problem, const JointResult& one_mount,
@@ -67,9 +82,10 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
   JointSettings two_mount_settings = joint_settings;
   two_mount_settings.imu_matrices = one_mount.imu_matrices;
   const JointEstimator estimator(two_mount_settings);
+  const JointProblem measured = withFieldsOf(problem, one_mount);
   int best = -1;
   for (int s = first; s <= last; ++s) {
-    JointProblem split = problem;
+    JointProblem split = measured;
     split.mount_change_pose = s;
     const JointResult two = estimator.solve(split, one_mount.R_cam_imu);
     MountChangeCandidate c;

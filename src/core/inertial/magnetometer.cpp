@@ -31,8 +31,8 @@ std::string describeFieldUnits(FieldUnits units, double norm) {
       out << " looks like microtesla; sensor_msgs/MagneticField is in tesla (set mag_scale: 1e-6)";
       break;
     case FieldUnits::kOutOfRange:
-      out << " is outside the earth's 15-100 microtesla (wrong unit, uncalibrated hard iron or a "
-             "strong disturbance)";
+      out << " is outside 1-1000 microtesla (the earth's field is 25-65 plus the sensor's hard "
+             "iron): a wrong unit or a strong disturbance";
       break;
   }
   return out.str();

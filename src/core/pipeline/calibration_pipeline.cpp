@@ -40,6 +40,10 @@ const char* toString(PoseImuSource source) {
   return "unknown";
 }
 
+bool usesJointEstimate(ImuOrientationSource source) {
+  return source == ImuOrientationSource::kJoint || source == ImuOrientationSource::kMagnetometer;
+}
+
 bool parseImuOrientationSource(const std::string& text, ImuOrientationSource* source) {
   if (text == "joint") {
     *source = ImuOrientationSource::kJoint;

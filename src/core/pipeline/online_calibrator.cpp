@@ -75,7 +75,7 @@ struct OnlineCalibrator::Impl {
   int inconsistent_poses = 0;  ///< pair modes: consecutive poses off the broadcast estimate
   bool capture_armed = false;
 
-  bool joint() const { return pipeline_settings.imu_orientation == ImuOrientationSource::kJoint; }
+  bool joint() const { return usesJointEstimate(pipeline_settings.imu_orientation); }
   void setState(CalibrationState s, const std::string& text) {
     const bool changed = s != state || text != message;
     state = s;

@@ -154,9 +154,11 @@ JointWindow::Entry CalibrationPipeline::Impl::jointMeasurements(const Stationary
     jp.accel_mean_m_s2 = segment.mean_accel_m_s2;
     jp.gyro_mean_rad_s = segment.gyro_bias_rad_s;
   }
-  if (pose.magnetometer_usable) {  // at least kMinFieldSamples samples
+  if (field.count >= kMinFieldSamples && field.mean_t.allFinite()) {
     jp.mag_mean_t = field.mean_t;
     jp.mag_mean_cov = field.mean_cov_t2;
+    // The raw check's verdict: the estimator re-judges it with the iron calibrated.
+    jp.mag_flagged = !pose.magnetometer_usable;
   }
   // The gyro since the previous rest: linked only while the chain holds (the same coverage test
   // as the gyro chain's integration).
@@ -342,7 +344,9 @@ AlignmentResult CalibrationPipeline::Impl::solve() const {
 WindowSnapshot CalibrationPipeline::Impl::snapshot() const {
   WindowSnapshot out;
   out.pairs = window.makePairs();
-  if (settings.imu_orientation == ImuOrientationSource::kJoint) out.joint = joint_window.problem();
+  if (usesJointEstimate(settings.imu_orientation)) out.joint = joint_window.problem();
+  // The paper's sensors: the IMU orientation from gravity and the field alone, the gyro left out.
+  if (settings.imu_orientation == ImuOrientationSource::kMagnetometer) out.joint.segments.clear();
   const std::size_t first = poses.size() - std::min(poses.size(), window.size());
   for (std::size_t i = first; i < poses.size(); ++i) out.pose_indices.push_back(poses[i].index);
   return out;
@@ -358,20 +362,23 @@ AlignmentResult solveWindow(const WindowSnapshot& window, const PipelineSettings
     return result;
   }
   AlignmentResult result = solveAlignment(pairs, settings.solver);
-  if (settings.imu_orientation != ImuOrientationSource::kJoint ||
-      result.status == SolveStatus::kBadInput || !result.R_cam_imu.allFinite()) {
+  if (!usesJointEstimate(settings.imu_orientation) || result.status == SolveStatus::kBadInput ||
+      !result.R_cam_imu.allFinite()) {
     return result;
   }
   // The joint estimate, started from the pair solve.
   const JointResult joint = JointEstimator(settings.joint).solve(window.joint, result.R_cam_imu);
+  const std::string sensors = settings.imu_orientation == ImuOrientationSource::kMagnetometer
+                                  ? " (camera, accelerometer, magnetometer; gyro not used)"
+                                  : "";
   if (joint.ok) {
     result.R_cam_imu = joint.R_cam_imu;
     result.quality.std_dev_deg = joint.std_dev_deg;
-    result.message = "joint estimate over " + std::to_string(window.joint.poses.size()) +
-                     " poses: chi2/dof " + fmt(joint.dof > 0 ? joint.chi2 / joint.dof : 0.0) +
-                     ", 1-sigma [" + fmt(joint.std_dev_deg.x(), 4) + " " +
-                     fmt(joint.std_dev_deg.y(), 4) + " " + fmt(joint.std_dev_deg.z(), 4) +
-                     "] deg; pairs: " + result.message;
+    result.message = "joint estimate" + sensors + " over " +
+                     std::to_string(window.joint.poses.size()) + " poses: chi2/dof " +
+                     fmt(joint.dof > 0 ? joint.chi2 / joint.dof : 0.0) + ", 1-sigma [" +
+                     fmt(joint.std_dev_deg.x(), 4) + " " + fmt(joint.std_dev_deg.y(), 4) + " " +
+                     fmt(joint.std_dev_deg.z(), 4) + "] deg; pairs: " + result.message;
   } else {
     result.message = "joint estimate failed (" + joint.message + "); pair solve: " + result.message;
   }
