@@ -98,9 +98,60 @@ TEST(MountChange, NotFlaggedWithOnePoseAfter) {
   JointSimulation sim = simulateJointProblem(optionsFor(Grade::kConsumer, 10), 310);
   remount(&sim, 9, turnAbout({0, 0, 1}, 3.0));
   const MountChangeTest test = runTest(sim);
-  // Nor at an earlier split that would take the changed pose with an unchanged one.
+  // Nor at an earlier split that would take the changed pose with an unchanged one: the split
+  // before the newest pose is the likeliest, but it only competes for the location.
   EXPECT_FALSE(test.detected) << test.message;
-  for (const MountChangeCandidate& c : test.candidates) EXPECT_LE(c.first_pose_after, 8);
+  EXPECT_TRUE(test.pending) << test.message;
+  EXPECT_EQ(test.first_pose_after, 9) << test.message;
+  for (const MountChangeCandidate& c : test.candidates) {
+    EXPECT_EQ(c.declarable, c.first_pose_after <= 8) << "split " << c.first_pose_after;
+  }
+}
+
+TEST(MountChange, AChangeBeforeTheNewestPoseIsNotSplitAPoseEarlyOnANoisyUnit) {
+  // An MPU-6050 class unit with its own priors (3 % scale, 2 % cross-axis, 0.6 m/s^2 accelerometer
+  // bias, 10 % soft iron): one pose 2 deg off is absorbed by the shared IMU model spread over every
+  // pose, so the split a pose early (the changed pose with an unchanged one) fitted every pose and
+  // was declared in 5 of these 10 recordings before the split before the newest pose took part.
+  // Now nothing is declared with one pose after the change, and with two the split is exact.
+  JointSimulationOptions options = optionsFor(Grade::kNoisy, 10);
+  options.gyro_bias_max_rad_s = deg2rad(3.0);
+  options.accel_noise_m_s2 = 0.2;
+  options.gyro_scale = options.accel_scale = 0.03;
+  options.gyro_cross_axis = options.accel_cross_axis = 0.02;
+  options.accel_bias_m_s2 = 0.6;
+  options.accel_bias_walk = 2e-3;
+  options.hard_iron_t = 40e-6;
+  options.soft_iron = 0.1;
+  options.mag_noise_t = 1.5e-6;
+  JointSettings joint;
+  joint.priors.gyro_scale = joint.priors.accel_scale = 0.03;
+  joint.priors.gyro_cross_axis = joint.priors.accel_cross_axis = 0.02;
+  joint.priors.accel_bias_m_s2 = 1.2;
+  joint.priors.accel_bias_walk_m_s2_sqrt_s = 2e-3;
+  joint.priors.hard_iron_t = 40e-6;
+  joint.priors.soft_iron_scale = joint.priors.soft_iron_cross = 0.1;
+  const Eigen::Vector3d axes[] = {{1, 0, 0}, {0, 1, 1}, {1, -1, 0.5}, {0.6, -0.8, 0}};
+  for (int seed = 0; seed < 10; ++seed) {
+    for (int first_after : {9, 8}) {
+      JointSimulation sim = simulateJointProblem(options, 500 + seed);
+      remount(&sim, first_after, turnAbout(axes[seed % 4], 2.0));
+      const JointResult one = JointEstimator(joint).solve(sim.problem, sim.R_cam_imu);
+      ASSERT_TRUE(one.ok) << one.message;
+      const MountChangeTest test = testMountChange(sim.problem, one, joint, MountChangeSettings{});
+      const std::string what = "seed " + std::to_string(seed) + ", change before pose " +
+                               std::to_string(first_after) + ": " + test.message;
+      if (first_after == 9) {
+        EXPECT_FALSE(test.detected) << what;
+        EXPECT_TRUE(test.pending) << what;
+      } else {
+        EXPECT_TRUE(test.detected) << what;
+        EXPECT_EQ(test.first_pose_after, 8) << what;
+        EXPECT_EQ(test.first_pose_kept, 8) << what;
+        EXPECT_NEAR(test.change_deg, 2.0, 0.3) << what;
+      }
+    }
+  }
 }
 
 TEST(MountChange, OneBadPoseIsNotARemount) {

@@ -5,10 +5,12 @@
 // clock jumps, forced calibration, manual capture and the worker thread.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <vector>
 
 #include "camera_imu_alignment/pipeline/online_calibrator.h"
+#include "camera_imu_alignment/simulation/trajectory.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "pipeline_simulation.h"
 
@@ -34,11 +36,17 @@ struct Recorder {
   std::vector<double> clock_jumps;
   /// Poses found when each remount was reported (how many poses it took).
   std::vector<int> poses_at_remount;
+  /// For each broadcast: the newest pose's index then (-1 before any) and remounts reported so far.
+  std::vector<int> newest_pose_at_broadcast, remounts_at_broadcast;
   OnlineCallbacks callbacks() {
     OnlineCallbacks cb;
     cb.on_pose = [this](const StationaryPose& p) { poses.push_back(p); };
     cb.on_estimate = [this](const EstimateEvent& e) { estimates.push_back(e); };
-    cb.on_broadcast = [this](const BroadcastEstimate& b) { broadcasts.push_back(b); };
+    cb.on_broadcast = [this](const BroadcastEstimate& b) {
+      broadcasts.push_back(b);
+      newest_pose_at_broadcast.push_back(poses.empty() ? -1 : poses.back().index);
+      remounts_at_broadcast.push_back(static_cast<int>(remounts.size()));
+    };
     cb.on_remount = [this](const RemountEvent& e) {
       remounts.push_back(e);
       poses_at_remount.push_back(static_cast<int>(poses.size()));
@@ -104,24 +112,32 @@ TEST(OnlineCalibrator, BroadcastsWithinATenthOfADegreeForEachGrade) {
 }
 
 TEST(OnlineCalibrator, RemountBeforeTheFirstBroadcastIsFoundWithinThreePoses) {
-  // The mount turns after the sixth pose; min_poses is high enough that nothing is broadcast
-  // before it (the case: a residual gate then blocked every broadcast for ever).
-  // The noisy grade (MPU-6050 class on a vibrating mount) is held to less: its change is found
-  // within 3 poses, but a 2 deg turn is split one pose early and the new mount's 7 poses do not
-  // give 0.2 deg (its 12-pose accuracy is 0.37 deg RMS, BENCHMARKS.md).
+  // The mount turns after the seventh pose; min_poses is high enough that nothing is broadcast
+  // before the seventh pose (the case: a residual gate then blocked every broadcast for
+  // ever). Every grade: found within 3 poses, split at the right pose (before the fix, a noisy
+  // unit's change was declared when one pose of the new mount was in, split one pose early, and
+  // the restarted window held an old-mount pose), and from then on only the new mount's poses are
+  // broadcast. Tactical and consumer units reach 0.2 deg from the 7 poses after the change; the
+  // noisy grade (MPU-6050 class on a vibrating mount) cannot (0.2 deg at 3 sigma takes it about
+  // 100 poses, BENCHMARKS.md "Online calibrator"): it gets 14 poses after the change and its
+  // broadcast must lie within 3 of its reported 1-sigma of the new mount.
   int case_index = 0;
   for (sim::ImuGrade grade :
        {sim::ImuGrade::kTactical, sim::ImuGrade::kConsumer, sim::ImuGrade::kNoisy}) {
     for (double turn_deg : {2.0, 5.0}) {
+      const bool noisy = grade == sim::ImuGrade::kNoisy;
       sim::SimulationConfig c = configFor(grade, 60 + case_index);
-      c.num_poses = 14;
+      c.num_poses = noisy ? 21 : 14;
       c.remount = true;
       c.remount_rotvec_cam = deg2rad(turn_deg) * Eigen::Vector3d(0.6, -0.8, 0.0);
+      const std::vector<sim::StationaryPose> planned = sim::Trajectory(c).poses();
+      c.remount_time_s = 0.5 * (planned[6].end_s + planned[7].start_s);
       OnlineSettings online = synchronous();
       online.min_poses = 7;
       const auto run = calibrate(c, online);
       ++case_index;
       const Recorder& r = run->recorder;
+      const Eigen::Matrix3d truth_after = run->simulated->trajectory.R_cam_imu_final();
       const double t_remount = run->simulated->trajectory.remountTime();
       int first_after = -1;
       for (const StationaryPose& p : r.poses) {
@@ -136,16 +152,110 @@ TEST(OnlineCalibrator, RemountBeforeTheFirstBroadcastIsFoundWithinThreePoses) {
       ASSERT_FALSE(r.remounts.empty()) << what << ": " << run->calibrator->stateMessage();
       // Found when the 2nd or 3rd pose of the new mount arrived.
       EXPECT_LE(r.poses_at_remount.front() - first_after, 3) << what;
-      if (grade == sim::ImuGrade::kNoisy) continue;
       EXPECT_EQ(r.remounts.front().first_pose_index, first_after) << what;
+      // The restarted window keeps no pose of the old mount (it may drop one of the new).
+      EXPECT_GE(r.remounts.front().first_pose_kept, first_after) << what;
+      EXPECT_LE(r.remounts.front().first_pose_kept, first_after + 1) << what;
       EXPECT_NEAR(r.remounts.front().change_deg, turn_deg, 0.3) << what;
       EXPECT_EQ(r.remounts.size(), 1u) << what << ": " << r.remounts.back().message;
-      // Then the new mount, from its own poses only, within 0.2 deg.
-      ASSERT_TRUE(run->calibrator->broadcast().has_value()) << what;
+      // After the change was found, only estimates from the new mount's poses are broadcast.
+      int new_mount_broadcasts = 0;
+      for (std::size_t i = 0; i < r.broadcasts.size(); ++i) {
+        if (r.remounts_at_broadcast[i] == 0) continue;
+        ++new_mount_broadcasts;
+        EXPECT_LE(r.broadcasts[i].poses, r.newest_pose_at_broadcast[i] - first_after + 1)
+            << what << ": broadcast " << i << " uses a pose of the old mount";
+      }
+      ASSERT_GT(new_mount_broadcasts, 0) << what << ": " << run->calibrator->stateMessage();
       const BroadcastEstimate& b = *run->calibrator->broadcast();
-      EXPECT_LT(errorDeg(b.R_cam_imu, run->simulated->trajectory.R_cam_imu_final()), 0.2) << what;
-      EXPECT_LE(b.poses, static_cast<int>(r.poses.size()) - first_after) << what;
+      if (!noisy) {
+        EXPECT_LT(errorDeg(b.R_cam_imu, truth_after), 0.2) << what;
+        continue;
+      }
+      // Per camera axis within 3 of its reported 1-sigma (left perturbation, camera axes).
+      const Eigen::Vector3d error_deg =
+          rad2deg(1.0) * logSO3(b.R_cam_imu * truth_after.transpose());
+      for (int axis = 0; axis < 3; ++axis) {
+        EXPECT_LE(std::abs(error_deg(axis)), 3.0 * b.std_dev_deg(axis))
+            << what << " axis " << axis << ": error " << error_deg.transpose() << " deg, 1-sigma "
+            << b.std_dev_deg.transpose() << " from " << b.poses << " poses";
+      }
+      std::printf(
+          "%s: broadcast %.3f deg off the new mount, 1-sigma [%.3f %.3f %.3f] deg, %d poses\n",
+          what.c_str(), errorDeg(b.R_cam_imu, truth_after), b.std_dev_deg(0), b.std_dev_deg(1),
+          b.std_dev_deg(2), b.poses);
     }
+  }
+}
+
+/// Forwards samples to `inner`, with the camera orientations of the frames from `from_s` on seen
+/// through a mount turned by `turn` (camera axes): R_target_cam' = R_target_cam turn^T.
+class TurnTheCameraFrom : public SampleSink {
+ public:
+  TurnTheCameraFrom(SampleSink* inner, double from_s, const Eigen::Matrix3d& turn)
+      : inner_(inner), from_s_(from_s), turn_(turn) {}
+  void addImu(const ImuSample& s) override { inner_->addImu(s); }
+  void addMagnetic(const MagneticSample& s) override { inner_->addMagnetic(s); }
+  bool setCameraIntrinsics(const CameraIntrinsics& i) override {
+    return inner_->setCameraIntrinsics(i);
+  }
+  void addFrame(const CameraFrame& frame) override {
+    CameraFrame out = frame;
+    if (out.R_target_cam && out.stamp_s >= from_s_) {
+      out.R_target_cam = Eigen::Matrix3d(*out.R_target_cam * turn_.transpose());
+    }
+    inner_->addFrame(out);
+  }
+  void rejectInput(RejectReason r, InputStream s, const std::string& d) override {
+    inner_->rejectInput(r, s, d);
+  }
+  ImuOrientationSource imuOrientationSource() const override {
+    return inner_->imuOrientationSource();
+  }
+
+ private:
+  SampleSink* inner_;
+  double from_s_;
+  Eigen::Matrix3d turn_;
+};
+
+TEST(OnlineCalibrator, ANewestPoseThatLooksLikeARemountIsNotBroadcast) {
+  // The last pose of a noisy unit seen through a mount turned by 1 deg: the change test finds a
+  // significant change before it but cannot declare it with one pose after (a remount or a bad
+  // pose), while the chi-square and 1-sigma gates would broadcast the estimate over both mounts.
+  // It is held back until the next pose decides; the broadcast estimate stays the one before.
+  for (std::uint64_t seed : {91, 102}) {
+    const sim::SimulationConfig c = configFor(sim::ImuGrade::kNoisy, seed);
+    const sim::SimulationRun simulated(c);
+    Recorder recorder;
+    PipelineSettings settings;
+    settings.joint = test::jointSettingsFor(c);
+    OnlineCalibrator calibrator(parseTargetYaml(sim::targetYaml(c.target), "target"), settings,
+                                synchronous(), recorder.callbacks());
+    TurnTheCameraFrom turned(&calibrator, simulated.trajectory.poses().back().start_s - 1.0,
+                             expSO3(deg2rad(1.0) * Eigen::Vector3d(0.6, -0.8, 0.0)));
+    test::feedSinkWithoutImages(simulated, &turned, 0.03, false, 50 + c.seed);
+    calibrator.finish();
+    calibrator.waitForSolves();
+    const std::string what = "seed " + std::to_string(seed);
+    ASSERT_TRUE(calibrator.lastEstimate().has_value()) << what;
+    const EstimateEvent& last = *calibrator.lastEstimate();
+    ASSERT_TRUE(last.mount_test.has_value()) << what;
+    EXPECT_TRUE(last.mount_test->pending) << what << ": " << last.mount_test->message;
+    EXPECT_EQ(last.mount_test->first_pose_after, static_cast<int>(last.window_poses) - 1) << what;
+    ASSERT_TRUE(calibrator.broadcast().has_value()) << what;
+    // The gates alone would broadcast it over the one before...
+    EXPECT_EQ(judgeEstimate(last.result, last.window_poses, calibrator.settings(),
+                            calibrator.broadcast(), false)
+                  .decision,
+              GateDecision::kBroadcast)
+        << what;
+    // ...but it is held back, and what is broadcast does not use the turned pose.
+    EXPECT_EQ(last.gate.decision, GateDecision::kReject) << what;
+    EXPECT_NE(last.gate.why.find("waiting for the next pose"), std::string::npos)
+        << what << ": " << last.gate.why;
+    EXPECT_LT(calibrator.broadcast()->poses, static_cast<int>(last.window_poses)) << what;
+    EXPECT_EQ(calibrator.remounts(), 0) << what;
   }
 }
 

@@ -126,6 +126,12 @@ struct JointSettings {
   /// The estimate is refused (ok = false) when its 1-sigma about a camera axis exceeds this (deg):
   /// the poses do not determine R_cam_imu (e.g. no rotation between them).
   double max_std_dev_deg = 10.0;
+  /// False: the fit alone (R_cam_imu, R_cam_imu_after_change, chi2, dof, p-value, per-pose
+  /// residuals); no covariance (zero 1-sigma), no IMU parameters. For callers that compare fits
+  /// (the mount-change test needs its chi-square drops only; the covariance is about a tenth of
+  /// a solve, and with one pose after a split and no magnetometer the second mount's rotation
+  /// about that pose's gravity is determined by nothing but a weak prior).
+  bool compute_covariance = true;
 
   // Observability: what the poses do not excite is not estimated (estimated = false, a note). By
   // default such a parameter keeps its prior as a constraint (it stays at its prior mean unless the

@@ -12,9 +12,22 @@
 // so that a unit whose noise the priors understate (chi2/dof > 1) does not read as a remount; the
 // p-value is Bonferroni-corrected for the number of candidates. A candidate counts only when the
 // two-mount model fits every pose: no pose's RMS whitened residual (JointResult::
-// pose_residual_norm) above max(1.5, 2.5 x the median pose's). A split next to the true one, or one
-// pose that is merely bad, leaves a pose unfitted however large D is. A change is declared when
-// the corrected p-value of the counting candidate with the largest D is below `level`.
+// pose_residual_norm) above max(1.5, 2.5 x the median pose's). A pose that is merely bad leaves
+// a pose unfitted however large D is.
+//
+// Where the change is: the candidate with the largest D that fits every pose is the
+// maximum-likelihood split (first_pose_after). Candidates run up to the newest pose; those with
+// fewer than min_poses_after poses after them compete for the location but are never declared.
+// Without them, a change before the newest pose was taken for one a pose earlier on noisy units:
+// the split one pose early, with an old-mount pose and the new one under the second mount, was
+// the best candidate on offer and its misfit spread over the shared IMU parameters (their wide
+// priors) instead of showing at one pose. Neighbouring splits can fit nearly equally well; the
+// window restarts from the latest candidate whose chi-square is within the chi-square(1) 95 %
+// quantile (times the best fit's chi2/dof when above 1) of the best (first_pose_kept): dropping a
+// new-mount pose costs a pose, keeping an old-mount pose biases the new estimate. A change is
+// declared when the corrected p-value of the best candidate is below `level` and that restart
+// candidate has min_poses_after poses after it; with fewer, it is `pending` (the next pose
+// decides; meanwhile nothing of the window should be broadcast).
 #pragma once
 
 #include <Eigen/Core>
@@ -44,8 +57,11 @@ struct MountChangeCandidate {
   double statistic = 0;      ///< D = chi2(one) - chi2(two)
   int dof = 0;               ///< dof_D
   double p_value = 1;        ///< of F, not corrected
-  double change_deg = 0;     ///< angle between the two mounts' R_cam_imu
-  bool solved = false;       ///< the two-mount solve succeeded
+  double scale = 1;          ///< max(1, chi2 / dof) of the two-mount fit
+  /// At least min_poses_after poses after it: can be declared (else it competes for the location).
+  bool declarable = false;
+  double change_deg = 0;  ///< angle between the two mounts' R_cam_imu
+  bool solved = false;    ///< the two-mount solve succeeded
   /// Worst pose residual over max(1.5, 2.5 x median) in the two-mount solve; <= 1: fits every pose.
   double worst_pose_misfit = 0;
   bool fits_every_pose = false;
@@ -53,10 +69,16 @@ struct MountChangeCandidate {
 
 struct MountChangeTest {
   bool tested = false;    ///< enough poses and a usable one-mount estimate
-  bool detected = false;  ///< a change at `first_pose_after`
-  int first_pose_after = -1;
+  bool detected = false;  ///< a change at `first_pose_after`: restart from `first_pose_kept`
+  /// A significant change whose restart candidate has fewer than min_poses_after poses after it:
+  /// not declared yet; the window mixes mounts (or its newest pose is bad).
+  bool pending = false;
+  int first_pose_after = -1;  ///< the maximum-likelihood split (index into JointProblem::poses)
+  /// The latest split as likely as it: the first pose a restarted window keeps (>= the above).
+  int first_pose_kept = -1;
   double p_value = 1;  ///< Bonferroni-corrected, of the best candidate
   double change_deg = 0;
+  /// Both mounts' estimates at the maximum-likelihood split.
   Eigen::Matrix3d R_cam_imu_before = Eigen::Matrix3d::Identity();
   Eigen::Matrix3d R_cam_imu_after = Eigen::Matrix3d::Identity();
   std::vector<MountChangeCandidate> candidates;

@@ -48,7 +48,10 @@ struct EstimateEvent {
 
 /// A mount change found.
 struct RemountEvent {
-  int first_pose_index = 0;    ///< StationaryPose::index of the first pose of the new mount
+  int first_pose_index = 0;  ///< StationaryPose::index of the first pose of the new mount
+  /// The window restarted from this pose (>= first_pose_index: a later split fitted as well, and
+  /// an old-mount pose would bias the new estimate).
+  int first_pose_kept = 0;
   double change_deg = 0;       ///< between the two mounts' estimates (0 when unknown: pair modes)
   std::size_t poses_kept = 0;  ///< poses of the new mount left in the window
   std::string message;

@@ -17,6 +17,10 @@ namespace {
 
 /// Shortest time between two rests' centres a walk residual assumes (s): keeps its sigma > 0.
 constexpr double kMinWalkDt = 1e-3;
+/// 1-sigma (rad) of the weak prior on each step of the second mount's rotation (30 deg): it
+/// holds what the poses after a change do not determine (one pose without the magnetometer
+/// leaves the rotation about its gravity free) and is far too weak to move what they do.
+constexpr double kAfterChangeStepSigmaRad = 0.52;
 
 ceres::LossFunction* makeLoss(const JointSettings& settings) {
   switch (settings.robust_loss) {
@@ -56,7 +60,14 @@ class Builder {
   BuiltProblem build(const std::vector<GyroPreintegration>& gyro) {
     const size_t n = problem_.poses.size();
     addBlock(state_.e_X.data(), 3);
-    if (problem_.mount_change_pose >= 0) addBlock(state_.e_X_after.data(), 3);
+    if (problem_.mount_change_pose >= 0) {
+      addBlock(state_.e_X_after.data(), 3);
+      // Not recorded: it is no measurement and stays out of the chi-square and its dof.
+      ceres_.AddResidualBlock(
+          new ceres::NormalPrior(Eigen::Matrix3d::Identity() / kAfterChangeStepSigmaRad,
+                                 ceres::Vector::Zero(3)),
+          nullptr, state_.e_X_after.data());
+    }
     addBlock(state_.e_T.data(), 3);
     // Without the magnetometer, W's yaw is a gauge: hold the increment about world z.
     if (!observability_.magnetometer_used) {

@@ -131,6 +131,7 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
     result->message = "the residuals are not finite at the estimate";
     return false;
   }
+  if (!settings.compute_covariance) return true;  // the fit alone (JointSettings)
 
   // Covariance of R_cam_imu and of every estimated block.
   std::map<const double*, int> requested;

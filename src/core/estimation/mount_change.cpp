@@ -35,6 +35,11 @@ double fisherUpperTail(double f, int d1, int d2) {
 
 namespace {
 
+/// A split whose two-mount chi-square exceeds the best split's by less than this (times the best
+/// fit's chi2/dof when above 1) is as likely as the best: the 95 % quantile of chi-square(1),
+/// the likelihood-ratio bound of a 95 % confidence set for a change point.
+constexpr double kSplitTolerance = 3.841;
+
 /// max_k norm_k / max(1.5, 2.5 x median norm): above 1, some pose is not fitted (in sigma units,
 /// relative to the typical pose, so that a unit whose noise the priors understate is judged by
 /// its own scale).
@@ -69,8 +74,8 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
   MountChangeTest test;
   const int n = static_cast<int>(problem.poses.size());
   const int first = std::max(settings.min_poses_before, n - settings.max_poses_after);
-  const int last = n - settings.min_poses_after;
-  if (!one_mount.ok || first > last) {
+  const int last_declarable = n - settings.min_poses_after;
+  if (!one_mount.ok || first > last_declarable) {
     test.message = one_mount.ok
                        ? "too few poses for the mount-change test (" + std::to_string(n) + ")"
                        : "no one-mount estimate to test against";
@@ -81,31 +86,42 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
   // model of T_g and T_a (no second model selection, whose choice could move the chi-square).
   JointSettings two_mount_settings = joint_settings;
   two_mount_settings.imu_matrices = one_mount.imu_matrices;
+  two_mount_settings.compute_covariance = false;  // D and the pose residuals need the fit alone
+  // ... and the magnetometer used exactly when the one-mount estimate used it (its fields, below),
+  // whatever the coverage rule would say of them.
+  two_mount_settings.use_magnetometer =
+      one_mount.intrinsics.magnetometer_used ? MagnetometerUse::kOn : MagnetometerUse::kOff;
+  two_mount_settings.min_mag_coverage_hard_iron = 0.0;
   const JointEstimator estimator(two_mount_settings);
+  // Candidates up to the newest pose: those with fewer than min_poses_after poses after them
+  // compete for the location only (a change just before the newest pose must not be taken for
+  // one a pose earlier, which would put an old-mount pose into the new mount).
   const JointProblem measured = withFieldsOf(problem, one_mount);
+  std::vector<Eigen::Matrix3d> before, after;
   int best = -1;
-  for (int s = first; s <= last; ++s) {
+  for (int s = first; s < n; ++s) {
     JointProblem split = measured;
     split.mount_change_pose = s;
     const JointResult two = estimator.solve(split, one_mount.R_cam_imu);
     MountChangeCandidate c;
     c.first_pose_after = s;
+    c.declarable = s <= last_declarable;
     if (two.ok && two.R_cam_imu_after_change && two.dof > 0) {
       c.solved = true;
       c.statistic = std::max(0.0, one_mount.chi2 - two.chi2);
       c.dof = one_mount.dof - two.dof;
-      const double scale = std::max(1.0, two.chi2 / two.dof);
-      c.p_value = fisherUpperTail(c.statistic / std::max(1, c.dof) / scale, c.dof, two.dof);
+      c.scale = std::max(1.0, two.chi2 / two.dof);
+      c.p_value = fisherUpperTail(c.statistic / std::max(1, c.dof) / c.scale, c.dof, two.dof);
       c.change_deg =
           rad2deg(rotationAngle(two.R_cam_imu.transpose() * *two.R_cam_imu_after_change));
       c.worst_pose_misfit = worstPoseMisfit(two.pose_residual_norm);
       c.fits_every_pose = c.worst_pose_misfit <= 1.0;
       if (c.fits_every_pose && (best < 0 || c.statistic > test.candidates[best].statistic)) {
         best = static_cast<int>(test.candidates.size());
-        test.R_cam_imu_before = two.R_cam_imu;
-        test.R_cam_imu_after = *two.R_cam_imu_after_change;
       }
     }
+    before.push_back(c.solved ? two.R_cam_imu : Eigen::Matrix3d::Identity());
+    after.push_back(c.solved ? *two.R_cam_imu_after_change : Eigen::Matrix3d::Identity());
     test.candidates.push_back(c);
   }
   if (best < 0) {
@@ -114,16 +130,40 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
   }
   const MountChangeCandidate& chosen = test.candidates[best];
   test.first_pose_after = chosen.first_pose_after;
+  test.R_cam_imu_before = before[best];
+  test.R_cam_imu_after = after[best];
   test.p_value = std::min(1.0, chosen.p_value * static_cast<double>(test.candidates.size()));
   test.change_deg = chosen.change_deg;
-  test.detected = test.p_value < settings.level;
-  char buffer[256];
+  // The window restarts from the latest split whose fit is not significantly worse than the
+  // best one (its chi-square within the chi-square(1) quantile, on the best fit's noise scale).
+  const double tolerance = kSplitTolerance * chosen.scale;
+  int kept = best;
+  for (int i = best + 1; i < static_cast<int>(test.candidates.size()); ++i) {
+    const MountChangeCandidate& c = test.candidates[i];
+    if (c.fits_every_pose && chosen.statistic - c.statistic <= tolerance) kept = i;
+  }
+  test.first_pose_kept = test.candidates[kept].first_pose_after;
+  const bool significant = test.p_value < settings.level;
+  test.pending = significant && !test.candidates[kept].declarable;
+  test.detected = significant && !test.pending;
+  char buffer[320];
   std::snprintf(buffer, sizeof(buffer),
                 "%s: split before pose %d of %d, mounts %.2f deg apart, chi2 drop %.1f (dof %d), "
                 "p %.2g (level %.2g)",
-                test.detected ? "mount changed" : "one mount", test.first_pose_after, n,
-                test.change_deg, chosen.statistic, chosen.dof, test.p_value, settings.level);
+                test.detected  ? "mount changed"
+                : test.pending ? "mount change suspected"
+                               : "one mount",
+                test.first_pose_after, n, test.change_deg, chosen.statistic, chosen.dof,
+                test.p_value, settings.level);
   test.message = buffer;
+  if (test.first_pose_kept != test.first_pose_after) {
+    test.message += "; as likely before pose " + std::to_string(test.first_pose_kept);
+  }
+  if (test.pending) {
+    test.message += ": fewer than remount_min_poses_after (" +
+                    std::to_string(settings.min_poses_after) +
+                    ") poses after it, waiting for the next pose";
+  }
   return test;
 }
 

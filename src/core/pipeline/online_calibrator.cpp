@@ -98,8 +98,9 @@ struct OnlineCalibrator::Impl {
   void poll();
   void apply(SolveOutput output);
   void applyRemount(const SolveOutput& output);
-  /// Keeps the window's poses from `first_index` on and says so (state, on_remount).
-  void restartWindowAt(int first_index, double change_deg, const std::string& text);
+  /// Keeps the window's poses from `kept_index` on (the mount changed before `first_index` <=
+  /// kept_index) and says so (state, on_remount).
+  void restartWindowAt(int first_index, int kept_index, double change_deg, const std::string& text);
   /// The output as an estimate judged by the gates against what is broadcast now.
   EstimateEvent judged(SolveOutput output) const;
   void applyEstimate(EstimateEvent event);
@@ -176,19 +177,19 @@ void OnlineCalibrator::Impl::checkPairRemount(const StationaryPose& pose) {
                 "mount changed before pose %d: the last %d poses disagree with the broadcast "
                 "estimate by more than remount_residual_deg %.2f deg; window restarted from them",
                 first_index, settings.remount_poses, settings.remount_residual_deg);
-  restartWindowAt(first_index, 0.0, text);
+  restartWindowAt(first_index, first_index, 0.0, text);
 }
 
-void OnlineCalibrator::Impl::restartWindowAt(int first_index, double change_deg,
+void OnlineCalibrator::Impl::restartWindowAt(int first_index, int kept_index, double change_deg,
                                              const std::string& text) {
-  pipeline->keepPosesFrom(first_index);
+  pipeline->keepPosesFrom(kept_index);
   ++generation;  // solves still running saw the old mount's poses
   ++remounts;
   inconsistent_poses = 0;
   recalibrating = fresh_start = true;
   setState(CalibrationState::kRecalibrating, text);
   if (callbacks.on_remount) {
-    callbacks.on_remount({first_index, change_deg, pipeline->windowSize(), text});
+    callbacks.on_remount({first_index, kept_index, change_deg, pipeline->windowSize(), text});
   }
 }
 
@@ -225,21 +226,37 @@ EstimateEvent OnlineCalibrator::Impl::judged(SolveOutput output) const {
   event.window_poses = output.window.pose_indices.size();
   event.mount_test = std::move(output.mount_test);
   event.gate = judgeEstimate(event.result, event.window_poses, settings, broadcast, fresh_start);
+  if (event.mount_test && event.mount_test->pending &&
+      event.gate.decision == GateDecision::kBroadcast) {
+    // The newest pose disagrees with the window as a remount would: an estimate over both mounts
+    // (or with a bad pose) is not broadcast; the next pose decides.
+    event.gate.decision = GateDecision::kReject;
+    event.gate.why = event.mount_test->message;
+  }
   return event;
 }
 
 void OnlineCalibrator::Impl::applyRemount(const SolveOutput& output) {
   const MountChangeTest& test = *output.mount_test;
   const int first_index = output.window.pose_indices.at(test.first_pose_after);
+  const int kept_index = output.window.pose_indices.at(test.first_pose_kept);
   const std::size_t kept = static_cast<std::size_t>(
       std::count_if(output.window.pose_indices.begin(), output.window.pose_indices.end(),
-                    [&](int index) { return index >= first_index; }));
-  char text[320];
-  std::snprintf(text, sizeof(text),
-                "mount changed before pose %d (by %.2f deg; chi-square change test p %.2g < "
-                "remount_level %.2g): window restarted from the %zu poses after it",
-                first_index, test.change_deg, test.p_value, settings.remount.level, kept);
-  restartWindowAt(first_index, test.change_deg, text);
+                    [&](int index) { return index >= kept_index; }));
+  char text[400];
+  const int length = std::snprintf(
+      text, sizeof(text),
+      "mount changed before pose %d (by %.2f deg; chi-square change test p %.2g < remount_level "
+      "%.2g): window restarted from the %zu poses after it",
+      first_index, test.change_deg, test.p_value, settings.remount.level, kept);
+  if (kept_index != first_index && length > 0 && length < static_cast<int>(sizeof(text))) {
+    std::snprintf(text + length, sizeof(text) - length,
+                  ", from pose %d on (a change before it fits as well; an old-mount pose would "
+                  "bias the new estimate)",
+                  kept_index);
+  }
+  const std::string message = text;
+  restartWindowAt(first_index, kept_index, test.change_deg, message);
   if (static_cast<int>(pipeline->windowSize()) >= pipeline_settings.min_poses_to_solve) {
     requestSolve();
   }
