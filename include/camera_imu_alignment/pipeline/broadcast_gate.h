@@ -26,7 +26,8 @@ struct GateOutcome {
 
 /// The gates in order:
 ///   solved and observable; finite; at least min_poses in the window;
-///   joint estimate (imu_orientation: joint or magnetometer): it succeeded and is consistent (chi-square p-value
+///   joint estimate (imu_orientation: joint or magnetometer): it succeeded and is consistent
+///   (chi-square p-value
 ///     >= consistency_level); pair modes: RMS pair residual <= max_residual_deg;
 ///   largest 1-sigma <= max_std_dev_deg;
 /// then against what is broadcast:

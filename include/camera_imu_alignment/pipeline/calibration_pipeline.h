@@ -77,11 +77,11 @@ struct PipelineSettings {
   PoseSettings pose;
   SolverOptions solver;
   ImuOrientationSource imu_orientation = ImuOrientationSource::kJoint;
-  JointSettings joint;                 ///< the joint estimate (imu_orientation: joint or magnetometer)
-  std::size_t window_poses = 30;       ///< sliding window of stationary poses
-  int min_poses_to_solve = 3;          ///< solve only with at least this many poses in the window
-  int min_frames_per_pose = 2;         ///< camera frames with a pose needed for a stationary pose
-  int max_frames_per_pose = 10;        ///< detection stops after this many good frames per rest
+  JointSettings joint;            ///< the joint estimate (imu_orientation: joint or magnetometer)
+  std::size_t window_poses = 30;  ///< sliding window of stationary poses
+  int min_poses_to_solve = 3;     ///< solve only with at least this many poses in the window
+  int min_frames_per_pose = 2;    ///< camera frames with a pose needed for a stationary pose
+  int max_frames_per_pose = 10;   ///< detection stops after this many good frames per rest
   double min_frame_interval_s = 0.15;  ///< frames closer than this to the last detected one skipped
   /// After kMissesBeforeBackoff failed detections in a row at one rest (target out of view, a
   /// miss costs up to 15x a hit), frames closer than this to the last attempt are skipped.
@@ -142,13 +142,13 @@ struct RejectedPose {
 /// A copy of the window, to be solved away from the pipeline (solveWindow), e.g. on a worker
 /// thread while samples keep arriving.
 struct WindowSnapshot {
-  RotationPairs pairs;            ///< PoseWindow::makePairs
-  JointProblem joint;             ///< the joint estimator's problem (imu_orientation: joint or magnetometer)
+  RotationPairs pairs;  ///< PoseWindow::makePairs
+  JointProblem joint;   ///< the joint estimator's problem (imu_orientation: joint or magnetometer)
   std::vector<int> pose_indices;  ///< StationaryPose::index of each window pose, oldest first
 };
 
-/// The solve of CalibrationPipeline::solve(): the pair estimators, then (imu_orientation: joint or magnetometer)
-/// the joint estimate started from the pair estimate. Pure: no pipeline state.
+/// The solve of CalibrationPipeline::solve(): the pair estimators, then (imu_orientation: joint or
+/// magnetometer) the joint estimate started from the pair estimate. Pure: no pipeline state.
 AlignmentResult solveWindow(const WindowSnapshot& window, const PipelineSettings& settings);
 
 struct PipelineCallbacks {

@@ -12,7 +12,8 @@
 // tests) a solve runs inside the sample call that completed a pose.
 //
 // Remount (a mount change) is found in two ways:
-//   joint estimate (imu_orientation: joint or magnetometer): after every solve the window is tested for a change
+//   joint estimate (imu_orientation: joint or magnetometer): after every solve the window is tested
+//   for a change
 //     point among its newest poses (estimation/mount_change.h), whether or not anything was
 //     broadcast; when found, the window restarts from the poses after the change and the next
 //     estimate is judged without the old one as a reference.
