@@ -2,25 +2,22 @@
 // roscore. Reads the bag with the rosbag C++ API and drives the core CalibrationPipeline (the same
 // class the nodelet drives). Exit codes (doc/CONVENTIONS.md): 0 success; 2 bad input or usage
 // (unreadable or truncated bag, missing topic, no camera data, bad target file); 3 not enough
-// information (too few poses, not observable: the message names the axis to rotate about).
+// information (too few poses, not observable: the message names the axis to rotate about); 4 the
+// estimate fails the quality gates or the mount moved during the recording. The bag is read by
+// bag_reader.h.
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
-#include <tf2/buffer_core.h>
-#include <tf2_msgs/TFMessage.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
-#include <map>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <vector>
 
+#include "bag_reader.h"
 #include "bag_topics.h"
 #include "camera_imu_alignment/io/calibration_report.h"
 #include "camera_imu_alignment/io/csv_io.h"
@@ -76,7 +73,8 @@ const char* kUsage =
     "                        poses CSV that solve_rotation --poses reads (doc/CONVENTIONS.md)\n"
     "  --quiet               no progress on stderr\n"
     "exit codes: 0 success, 2 bad input or usage, 3 not enough information (the message says what\n"
-    "motion is missing)\n";
+    "motion is missing), 4 an estimate that fails the quality gates or a mount that moved during\n"
+    "the recording (the verdict line says which; nothing is written)\n";
 
 /// --imu-yaml: the Kalibr imu.yaml of the joint estimate. White noise densities from the rests:
 /// the median over the rests of the per-sample scatter times sqrt(sample period).
@@ -108,143 +106,6 @@ bool writeImuYaml(const std::string& path, const cia::ReportInput& report,
     return false;
   }
   return true;
-}
-
-/// Progress on stderr: a live line on a terminal, plain lines every 10% otherwise.
-class Progress {
- public:
-  Progress(bool enabled, double start_s, double end_s)
-      : enabled_(enabled), tty_(isatty(fileno(stderr))), start_(start_s), end_(end_s) {}
-  void update(double t, const cia::OnlineCalibrator& calibrator, bool force = false) {
-    const cia::CalibrationPipeline& pipeline = calibrator.pipeline();
-    if (!enabled_) return;
-    const double span = end_ - start_;
-    const int percent = span > 0.0 ? static_cast<int>(100.0 * (t - start_) / span) : 100;
-    const int step = tty_ ? 1 : 10;
-    if (!force && percent / step == last_ / step) return;
-    last_ = percent;
-    std::ostringstream line;
-    line << "[calibrate_bag] " << std::setw(3) << std::min(percent, 100) << "% of bag time, "
-         << pipeline.segments().size() << " rests, " << pipeline.poses().size() << " poses";
-    if (const auto& estimate = calibrator.lastEstimate()) {
-      const cia::AlignmentResult& result = estimate->result;
-      line << ", R_cam_imu " << cia::rollPitchYawText(result.R_cam_imu, 2) << " +- " << std::fixed
-           << std::setprecision(2) << result.quality.std_dev_deg.maxCoeff();
-    }
-    if (tty_) {
-      std::cerr << "\r\033[K" << line.str() << std::flush;
-    } else {
-      std::cerr << line.str() << "\n";
-    }
-  }
-  void done() {
-    if (enabled_ && tty_) std::cerr << "\n";
-  }
-
- private:
-  bool enabled_, tty_;
-  double start_, end_;
-  int last_ = -100;
-};
-
-/// Prints the first few rejections of each reason, naming the bag topic, then only counts (the
-/// summary at the end has them all).
-class RejectLog {
- public:
-  explicit RejectLog(const cia::BagTopics& topics) : topics_(topics) {}
-  void operator()(cia::RejectReason reason, cia::InputStream stream, const std::string& detail) {
-    const int n = ++shown_[reason];
-    if (n <= 3) {
-      std::cerr << "[calibrate_bag] " << topicOf(stream) << ": rejected (" << cia::toString(reason)
-                << "): " << detail << "\n";
-    }
-    if (n == 3) {
-      std::cerr << "[calibrate_bag] (further '" << cia::toString(reason)
-                << "' rejections are counted, not shown)\n";
-    }
-  }
-
- private:
-  std::string topicOf(cia::InputStream stream) const {
-    switch (stream) {
-      case cia::InputStream::kImu:
-        return topics_.imu;
-      case cia::InputStream::kMagnetometer:
-        return topics_.mag;
-      case cia::InputStream::kImage:
-        return topics_.image;
-      case cia::InputStream::kCameraInfo:
-        return topics_.camera_info;
-      case cia::InputStream::kCameraPose:
-        break;
-    }
-    return cia::toString(stream);
-  }
-
-  cia::BagTopics topics_;
-  std::map<cia::RejectReason, int> shown_;
-};
-
-struct RunInfo {
-  std::string camera_frame, imu_frame;
-  std::uint64_t image_messages = 0, info_messages = 0;
-  double start_s = 0.0, end_s = 0.0;
-};
-
-/// The bag's static transforms (/tf_static, e.g. the magnetometer's frame in the IMU's).
-void readStaticTransforms(const rosbag::Bag& bag, tf2::BufferCore* tf) {
-  rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{"/tf_static", "tf_static"}));
-  for (const rosbag::MessageInstance& m : view) {
-    const auto msg = m.instantiate<tf2_msgs::TFMessage>();
-    if (!msg) continue;
-    for (geometry_msgs::TransformStamped t : msg->transforms) {
-      t.header.frame_id = cia::normalizeFrameId(t.header.frame_id);
-      t.child_frame_id = cia::normalizeFrameId(t.child_frame_id);
-      tf->setTransform(t, "bag", true);  // a bad transform is refused by tf2 (logged)
-    }
-  }
-}
-
-/// Feeds every message of the selected topics to the pipeline. Throws rosbag exceptions on a
-/// corrupt or truncated bag.
-void readBag(const rosbag::Bag& bag, const cia::BagTopics& topics,
-             cia::OnlineCalibrator* calibrator, Progress* progress, RunInfo* info) {
-  std::vector<std::string> names = {topics.imu};
-  for (const auto& t : {topics.mag, topics.image, topics.camera_info}) {
-    if (!t.empty()) names.push_back(t);
-  }
-  rosbag::View view(bag, rosbag::TopicQuery(names));
-  // The nodelet's checks and conversions (MessageInput), so that both refuse the same messages.
-  cia::MessageInput input(calibrator, [](const std::string& notice) {
-    std::cerr << "[calibrate_bag] note: " << notice << "\n";
-  });
-  tf2::BufferCore static_tf;
-  readStaticTransforms(bag, &static_tf);
-  input.setTransforms(&static_tf);
-  for (const rosbag::MessageInstance& m : view) {
-    const std::string& topic = m.getTopic();
-    if (topic == topics.imu) {
-      if (const auto msg = m.instantiate<sensor_msgs::Imu>()) input.addImu(*msg);
-    } else if (topic == topics.mag) {
-      if (const auto msg = m.instantiate<sensor_msgs::MagneticField>()) input.addMagnetic(*msg);
-    } else if (topic == topics.camera_info) {
-      ++info->info_messages;
-      if (const auto msg = m.instantiate<sensor_msgs::CameraInfo>()) input.setCameraInfo(*msg);
-    } else if (topic == topics.image) {
-      ++info->image_messages;
-      if (topics.image_compressed) {
-        if (const auto msg = m.instantiate<sensor_msgs::CompressedImage>()) input.addImage(*msg);
-      } else if (const auto msg = m.instantiate<sensor_msgs::Image>()) {
-        input.addImage(*msg);
-      }
-    }
-    progress->update(m.getTime().toSec(), *calibrator);
-  }
-  info->imu_frame = input.imuFrame();
-  info->camera_frame = input.cameraFrame();
-  calibrator->finish();
-  progress->update(info->end_s, *calibrator, true);
-  progress->done();
 }
 
 /// The poses of the pipeline's window (those the estimate used), as the poses CSV holds them: the
@@ -303,7 +164,7 @@ int run(const cia::CliArgs& args) {
   const std::string bag_path = args.get("--bag");
   rosbag::Bag bag;
   cia::BagTopics topics;
-  RunInfo info;
+  cia::BagRunInfo info;
   try {
     bag.open(bag_path, rosbag::bagmode::Read);
     cia::BagTopics requested{args.get("--imu-topic"), args.get("--mag-topic"),
@@ -324,7 +185,7 @@ int run(const cia::CliArgs& args) {
 
   // --- Run the pipeline over the bag.
   // The nodelet's calibrator (poses, solves, change detection, gates), solving as poses arrive.
-  RejectLog reject_log(topics);
+  cia::BagRejectLog reject_log(topics);
   std::vector<cia::RemountEvent> remounts;
   cia::OnlineCallbacks callbacks;
   callbacks.on_reject = [&](cia::RejectReason r, cia::InputStream stream, const std::string& d) {
@@ -340,7 +201,7 @@ int run(const cia::CliArgs& args) {
     return kExitBadInput;
   }
   const cia::CalibrationPipeline& pipeline = calibrator->pipeline();
-  Progress progress(!args.has("--quiet"), info.start_s, info.end_s);
+  cia::BagProgress progress(!args.has("--quiet"), info.start_s, info.end_s);
   try {
     readBag(bag, topics, calibrator.get(), &progress, &info);
   } catch (const std::exception& e) {
