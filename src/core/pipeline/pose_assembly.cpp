@@ -374,6 +374,7 @@ AlignmentResult solveWindow(const WindowSnapshot& window, const PipelineSettings
   if (joint.ok) {
     result.R_cam_imu = joint.R_cam_imu;
     result.quality.std_dev_deg = joint.std_dev_deg;
+    result.quality.covariance_rad2 = joint.covariance_rad2;  // the two stay one estimate's
     result.message = "joint estimate" + sensors + " over " +
                      std::to_string(window.joint.poses.size()) + " poses: chi2/dof " +
                      fmt(joint.dof > 0 ? joint.chi2 / joint.dof : 0.0) + ", 1-sigma [" +
