@@ -149,7 +149,7 @@ int run(const cia::CliArgs& args) {
   if (args.has("--imu-orientation") &&
       !cia::parseImuOrientationSource(args.get("--imu-orientation"), &settings.imu_orientation)) {
     std::cerr << "calibrate_bag: --imu-orientation " << args.get("--imu-orientation")
-              << ": must be auto or magnetometer\n";
+              << ": must be joint, auto, magnetometer or message\n";
     return kExitBadInput;
   }
   std::optional<cia::StoredCalibration> truth;
