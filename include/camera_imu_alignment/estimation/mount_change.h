@@ -7,7 +7,11 @@
 // unused). The statistic is the drop of the chi-square,
 //   D(s) = chi2(one mount) - chi2(two mounts, split at s),
 // which without a change is chi-square distributed with dof(one) - dof(two) degrees of freedom
-// (3 for the second rotation + 3 for the gyro motion left out). It is judged as an F statistic,
+// (3 for the second rotation + 3 for the gyro motion left out). Both fits have the same model of
+// T_g and T_a: the one-mount estimate's, except that where its model selection held them at
+// identity (ImuMatrixModel::kSelect) both are fitted with them estimated, since a window that
+// mixes two mounts can make the selection drop matrices the unit needs. It is judged as an F
+// statistic,
 //   F = (D / dof_D) / max(1, chi2_two / dof_two),
 // so that a unit whose noise the priors understate (chi2/dof > 1) does not read as a remount; the
 // p-value is Bonferroni-corrected for the number of candidates. A candidate counts only when the

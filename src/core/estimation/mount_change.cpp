@@ -83,7 +83,7 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
   }
   test.tested = true;
   // The two-mount model differs from the one-mount model by the second rotation alone: the same
-  // model of T_g and T_a (no second model selection, whose choice could move the chi-square).
+  // model of T_g and T_a (no second model selection, whose choice could move the chi-square)...
   JointSettings two_mount_settings = joint_settings;
   two_mount_settings.imu_matrices = one_mount.imu_matrices;
   two_mount_settings.compute_covariance = false;  // D and the pose residuals need the fit alone
@@ -92,24 +92,40 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
   two_mount_settings.use_magnetometer =
       one_mount.intrinsics.magnetometer_used ? MagnetometerUse::kOn : MagnetometerUse::kOff;
   two_mount_settings.min_mag_coverage_hard_iron = 0.0;
-  const JointEstimator estimator(two_mount_settings);
   // Candidates up to the newest pose: those with fewer than min_poses_after poses after them
   // compete for the location only (a change just before the newest pose must not be taken for
   // one a pose earlier, which would put an old-mount pose into the new mount).
   const JointProblem measured = withFieldsOf(problem, one_mount);
+  // A window that mixes two mounts fits no model well, and the model selection may then hold T_g
+  // and T_a at identity for a unit that needs them (a tactical unit's 0.1 % scale is tens of
+  // sigma); every two-mount fit would inherit that misfit and none would fit every pose (seen on
+  // 2 of 20 tactical recordings with a 5 deg turn). Where the selection chose identity, both
+  // models are compared with the matrices estimated: the one-mount fit once more.
+  JointResult reference = one_mount;
+  if (joint_settings.imu_matrices == ImuMatrixModel::kSelect &&
+      one_mount.imu_matrices == ImuMatrixModel::kIdentity) {
+    JointSettings estimated = two_mount_settings;
+    estimated.imu_matrices = ImuMatrixModel::kEstimate;
+    const JointResult refit = JointEstimator(estimated).solve(measured, one_mount.R_cam_imu);
+    if (refit.ok && refit.dof > 0) {
+      reference = refit;
+      two_mount_settings.imu_matrices = ImuMatrixModel::kEstimate;
+    }
+  }
+  const JointEstimator estimator(two_mount_settings);
   std::vector<Eigen::Matrix3d> before, after;
   int best = -1;
   for (int s = first; s < n; ++s) {
     JointProblem split = measured;
     split.mount_change_pose = s;
-    const JointResult two = estimator.solve(split, one_mount.R_cam_imu);
+    const JointResult two = estimator.solve(split, reference.R_cam_imu);
     MountChangeCandidate c;
     c.first_pose_after = s;
     c.declarable = s <= last_declarable;
     if (two.ok && two.R_cam_imu_after_change && two.dof > 0) {
       c.solved = true;
-      c.statistic = std::max(0.0, one_mount.chi2 - two.chi2);
-      c.dof = one_mount.dof - two.dof;
+      c.statistic = std::max(0.0, reference.chi2 - two.chi2);
+      c.dof = reference.dof - two.dof;
       c.scale = std::max(1.0, two.chi2 / two.dof);
       c.p_value = fisherUpperTail(c.statistic / std::max(1, c.dof) / c.scale, c.dof, two.dof);
       c.change_deg =
