@@ -27,6 +27,19 @@ sim::SimulationConfig configFor(sim::ImuGrade grade, std::uint64_t seed) {
   return c;
 }
 
+/// `grade`'s recording whose mount turns by `turn_deg` about camera (0.6, -0.8, 0) between the
+/// 7th and the 8th of `num_poses` poses.
+sim::SimulationConfig remountedConfig(sim::ImuGrade grade, std::uint64_t seed, double turn_deg,
+                                      int num_poses) {
+  sim::SimulationConfig c = configFor(grade, seed);
+  c.num_poses = num_poses;
+  c.remount = true;
+  c.remount_rotvec_cam = deg2rad(turn_deg) * Eigen::Vector3d(0.6, -0.8, 0.0);
+  const std::vector<sim::StationaryPose> planned = sim::Trajectory(c).poses();
+  c.remount_time_s = 0.5 * (planned[6].end_s + planned[7].start_s);
+  return c;
+}
+
 /// Everything the calibrator said, in order.
 struct Recorder {
   std::vector<StationaryPose> poses;
@@ -126,12 +139,8 @@ TEST(OnlineCalibrator, RemountBeforeTheFirstBroadcastIsFoundWithinThreePoses) {
        {sim::ImuGrade::kTactical, sim::ImuGrade::kConsumer, sim::ImuGrade::kNoisy}) {
     for (double turn_deg : {2.0, 5.0}) {
       const bool noisy = grade == sim::ImuGrade::kNoisy;
-      sim::SimulationConfig c = configFor(grade, 60 + case_index);
-      c.num_poses = noisy ? 21 : 14;
-      c.remount = true;
-      c.remount_rotvec_cam = deg2rad(turn_deg) * Eigen::Vector3d(0.6, -0.8, 0.0);
-      const std::vector<sim::StationaryPose> planned = sim::Trajectory(c).poses();
-      c.remount_time_s = 0.5 * (planned[6].end_s + planned[7].start_s);
+      const sim::SimulationConfig c =
+          remountedConfig(grade, 60 + case_index, turn_deg, noisy ? 21 : 14);
       OnlineSettings online = synchronous();
       online.min_poses = 7;
       const auto run = calibrate(c, online);
@@ -194,12 +203,7 @@ TEST(OnlineCalibrator, ATacticalUnitsTurnIsFoundAlthoughTheMixedWindowDropsItsMa
   // the two-mount fits inherited that, fitted no pose set well, and a 5 deg turn was never found.
   // The change test now fits both models with the matrices estimated there.
   for (std::uint64_t seed : {65u, 71u}) {
-    sim::SimulationConfig c = configFor(sim::ImuGrade::kTactical, seed);
-    c.num_poses = 14;
-    c.remount = true;
-    c.remount_rotvec_cam = deg2rad(5.0) * Eigen::Vector3d(0.6, -0.8, 0.0);
-    const std::vector<sim::StationaryPose> planned = sim::Trajectory(c).poses();
-    c.remount_time_s = 0.5 * (planned[6].end_s + planned[7].start_s);
+    const sim::SimulationConfig c = remountedConfig(sim::ImuGrade::kTactical, seed, 5.0, 14);
     OnlineSettings online = synchronous();
     online.min_poses = 7;
     const auto run = calibrate(c, online);

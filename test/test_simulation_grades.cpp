@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -341,29 +342,20 @@ TEST(SimulationGrades, TheDetectorFindsEveryRestOfEveryGradeAndNoneWhileMoving) 
       c.num_poses = 12;
       const SimulationRun run(c);
       std::vector<ImuSample> samples;
-      for (const InertialSample& m : run.imu) {
-        ImuSample s;
-        s.stamp_s = m.t;
-        s.gyro_rad_s = m.gyro;
-        s.accel_m_s2 = m.accel;
-        samples.push_back(s);
-      }
+      for (const InertialSample& m : run.imu) samples.push_back({m.t, m.gyro, m.accel});
       const std::vector<StationarySegment> segments = detectStationarySegments(samples);
       const std::vector<StationaryPose>& rests = run.trajectory.poses();
+      const auto inside = [](const StationarySegment& s, const StationaryPose& rest) {
+        return s.start_s >= rest.start_s - 1e-9 && s.end_s <= rest.end_s + 1e-9;
+      };
       int found = 0, stray = 0;
       for (const StationaryPose& rest : rests) {
-        int inside = 0;
-        for (const StationarySegment& s : segments) {
-          inside += s.start_s >= rest.start_s - 1e-9 && s.end_s <= rest.end_s + 1e-9;
-        }
-        found += inside == 1;
+        found += std::count_if(segments.begin(), segments.end(),
+                               [&](const StationarySegment& s) { return inside(s, rest); }) == 1;
       }
       for (const StationarySegment& s : segments) {
-        bool within_a_rest = false;
-        for (const StationaryPose& rest : rests) {
-          within_a_rest |= s.start_s >= rest.start_s - 1e-9 && s.end_s <= rest.end_s + 1e-9;
-        }
-        stray += !within_a_rest;
+        stray += std::none_of(rests.begin(), rests.end(),
+                              [&](const StationaryPose& rest) { return inside(s, rest); });
       }
       EXPECT_EQ(found, 12) << toString(grade) << " seed " << seed;
       EXPECT_EQ(stray, 0) << toString(grade) << " seed " << seed;
