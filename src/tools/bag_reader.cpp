@@ -18,8 +18,6 @@
 #include <sstream>
 #include <vector>
 
-#include "camera_imu_alignment/io/csv_io.h"
-#include "camera_imu_alignment/io/default_frames.h"
 #include "camera_imu_alignment/ros/message_input.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 
