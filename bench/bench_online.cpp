@@ -16,7 +16,7 @@
 
 #include "../test/pipeline_simulation.h"
 #include "camera_imu_alignment/estimation/mount_change.h"
-#include "camera_imu_alignment/pipeline/online_calibrator.h"
+#include "camera_imu_alignment/online/online_calibrator.h"
 
 namespace cia = camera_imu_alignment;
 namespace sim = camera_imu_alignment::simulation;

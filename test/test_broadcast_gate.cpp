@@ -7,7 +7,7 @@
 #include <Eigen/Geometry>
 #include <limits>
 
-#include "camera_imu_alignment/pipeline/broadcast_gate.h"
+#include "camera_imu_alignment/online/broadcast_gate.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {

@@ -13,8 +13,8 @@
 #include <thread>
 #include <vector>
 
+#include "camera_imu_alignment/online/clock_jump.h"
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
-#include "camera_imu_alignment/pipeline/clock_jump.h"
 #include "camera_imu_alignment/ros/message_conversion.h"
 #include "camera_imu_alignment/ros/message_input.h"
 #include "camera_imu_alignment/solver/rotation_math.h"

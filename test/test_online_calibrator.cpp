@@ -1,4 +1,4 @@
-// The online calibrator (pipeline/online_calibrator.h) without ROS, on simulated sample streams
+// The online calibrator (online/online_calibrator.h) without ROS, on simulated sample streams
 // (camera orientations given, no images) of several IMU grades: broadcasts within 0.2 deg of the
 // truth, finds a remount before anything was broadcast within 3 poses and then broadcasts the new
 // mount from the poses after it alone, raises no false remount on unchanged recordings; reset,
@@ -9,7 +9,7 @@
 #include <cstdio>
 #include <vector>
 
-#include "camera_imu_alignment/pipeline/online_calibrator.h"
+#include "camera_imu_alignment/online/online_calibrator.h"
 #include "camera_imu_alignment/simulation/trajectory.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "pipeline_simulation.h"

@@ -7,9 +7,9 @@
 #include <fstream>
 #include <set>
 
+#include "camera_imu_alignment/config/online_config.h"
+#include "camera_imu_alignment/config/pipeline_config.h"
 #include "camera_imu_alignment/io/input_error.h"
-#include "camera_imu_alignment/pipeline/online_config.h"
-#include "camera_imu_alignment/pipeline/pipeline_config.h"
 #include "camera_imu_alignment/ros/wrapper_settings.h"
 #include "test_helpers.h"
 

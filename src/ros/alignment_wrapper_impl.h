@@ -23,7 +23,7 @@
 #include <optional>
 
 #include "camera_imu_alignment/Calibrate.h"
-#include "camera_imu_alignment/pipeline/online_calibrator.h"
+#include "camera_imu_alignment/online/online_calibrator.h"
 #include "camera_imu_alignment/ros/alignment_wrapper.h"
 #include "camera_imu_alignment/ros/message_input.h"
 #include "camera_imu_alignment/ros/stream_watch.h"

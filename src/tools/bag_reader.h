@@ -10,8 +10,8 @@
 #include <string>
 
 #include "bag_topics.h"
+#include "camera_imu_alignment/online/online_calibrator.h"
 #include "camera_imu_alignment/pipeline/input_rejections.h"
-#include "camera_imu_alignment/pipeline/online_calibrator.h"
 
 namespace camera_imu_alignment {
 

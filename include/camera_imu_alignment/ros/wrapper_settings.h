@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "camera_imu_alignment/config/pipeline_config.h"
+#include "camera_imu_alignment/online/online_types.h"
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
-#include "camera_imu_alignment/pipeline/online_types.h"
-#include "camera_imu_alignment/pipeline/pipeline_config.h"
 
 namespace camera_imu_alignment {
 

@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "camera_imu_alignment/estimation/joint_types.h"
+#include "camera_imu_alignment/results/joint_result.h"
 #include "camera_imu_alignment/solver/optimal_solver.h"
 #include "camera_imu_alignment/solver/rotation_pair.h"
 #include "camera_imu_alignment/solver/solution_quality.h"

@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
+#include "camera_imu_alignment/config/setting_keys.h"
+#include "camera_imu_alignment/online/online_types.h"
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
-#include "camera_imu_alignment/pipeline/online_types.h"
-#include "camera_imu_alignment/pipeline/setting_keys.h"
 
 namespace camera_imu_alignment {
 

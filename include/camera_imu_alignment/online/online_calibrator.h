@@ -30,10 +30,10 @@
 #include <optional>
 #include <string>
 
-#include "camera_imu_alignment/pipeline/broadcast_gate.h"
+#include "camera_imu_alignment/online/broadcast_gate.h"
+#include "camera_imu_alignment/online/clock_jump.h"
+#include "camera_imu_alignment/online/online_types.h"
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
-#include "camera_imu_alignment/pipeline/clock_jump.h"
-#include "camera_imu_alignment/pipeline/online_types.h"
 #include "camera_imu_alignment/pipeline/sample_sink.h"
 
 namespace camera_imu_alignment {

@@ -10,8 +10,8 @@
 #include <optional>
 #include <thread>
 
+#include "camera_imu_alignment/online/online_types.h"
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
-#include "camera_imu_alignment/pipeline/online_types.h"
 
 namespace camera_imu_alignment {
 

@@ -1,4 +1,4 @@
-#include "camera_imu_alignment/pipeline/pipeline_config.h"
+#include "camera_imu_alignment/config/pipeline_config.h"
 
 #include <yaml-cpp/yaml.h>
 

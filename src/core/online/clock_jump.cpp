@@ -1,5 +1,5 @@
 // ClockJumpDetector: per-input newest stamps; a jump back resets all of them.
-#include "camera_imu_alignment/pipeline/clock_jump.h"
+#include "camera_imu_alignment/online/clock_jump.h"
 
 #include <algorithm>
 

@@ -1,5 +1,5 @@
 // The quality gates (broadcast_gate.h).
-#include "camera_imu_alignment/pipeline/broadcast_gate.h"
+#include "camera_imu_alignment/online/broadcast_gate.h"
 
 #include <Eigen/LU>
 #include <boost/math/distributions/chi_squared.hpp>

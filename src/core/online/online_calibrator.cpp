@@ -1,5 +1,5 @@
 // OnlineCalibrator (online_calibrator.h): state, gates, remounts; solving in solve_worker.
-#include "camera_imu_alignment/pipeline/online_calibrator.h"
+#include "camera_imu_alignment/online/online_calibrator.h"
 
 #include <algorithm>
 #include <cmath>

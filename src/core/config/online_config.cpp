@@ -1,11 +1,11 @@
 // The calibrator's setting keys (online_config.h).
-#include "camera_imu_alignment/pipeline/online_config.h"
+#include "camera_imu_alignment/config/online_config.h"
 
 #include <fstream>
 #include <sstream>
 
+#include "camera_imu_alignment/config/pipeline_config.h"
 #include "camera_imu_alignment/io/input_error.h"
-#include "camera_imu_alignment/pipeline/pipeline_config.h"
 
 namespace camera_imu_alignment {
 namespace {

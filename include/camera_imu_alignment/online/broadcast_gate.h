@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "camera_imu_alignment/pipeline/online_types.h"
+#include "camera_imu_alignment/online/online_types.h"
 #include "camera_imu_alignment/solver/alignment_solver.h"
 
 namespace camera_imu_alignment {

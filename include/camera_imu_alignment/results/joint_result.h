@@ -1,0 +1,98 @@
+// What the joint maximum-likelihood estimate (estimation/joint_estimator.h) answers: R_cam_imu with
+// its covariance, the IMU model at the estimate and the chi-square consistency figures. A room of
+// its own so that the solver's AlignmentResult can carry it without reaching into the estimator.
+// Frames and units as estimation/joint_types.h states them (camera axes, IMU = accelerometer axes,
+// SI units).
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace camera_imu_alignment {
+
+enum class ImuMatrixModel {
+  kEstimate,  ///< estimated, held by their priors (ImuModelPriors)
+  kIdentity,  ///< held at I without uncertainty: a unit whose scale and axes are calibrated
+  /// Both solved; T = I kept unless the likelihood ratio rejects it (chi2 of the identity model
+  /// minus the estimated one's, chi-square with as many degrees of freedom as free entries of T,
+  /// p below model_selection_level): the data's own evidence for scale and misalignment errors.
+  kSelect
+};
+
+/// One reported parameter block.
+struct EstimatedValue {
+  std::string name;       ///< e.g. "gyro_matrix_column_x", "accel_bias_m_s2"
+  Eigen::VectorXd value;  ///< in the block's units
+  Eigen::VectorXd sigma;  ///< 1-sigma: posterior when estimated, the prior's when held
+  bool estimated = false;
+};
+
+/// The IMU model at the estimate. Sigmas are 1-sigma (posterior, or the prior's when held).
+struct ImuIntrinsics {
+  Eigen::Matrix3d gyro_matrix = Eigen::Matrix3d::Identity();  ///< T_g
+  Eigen::Matrix3d gyro_matrix_sigma = Eigen::Matrix3d::Zero();
+  std::array<bool, 3> gyro_matrix_column_estimated = {false, false, false};  ///< per gyro axis
+  Eigen::Vector3d gyro_bias_rad_s = Eigen::Vector3d::Zero();  ///< at the first pose with gyro data
+  Eigen::Vector3d gyro_bias_sigma_rad_s = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> gyro_bias_per_pose_rad_s;  ///< per pose (the rest mean if unused)
+  Eigen::Matrix3d accel_matrix = Eigen::Matrix3d::Identity();  ///< T_a
+  Eigen::Matrix3d accel_matrix_sigma = Eigen::Matrix3d::Zero();
+  bool accel_matrix_estimated = false;
+  Eigen::Vector3d accel_bias_m_s2 = Eigen::Vector3d::Zero();  ///< b_a at the first pose
+  Eigen::Vector3d accel_bias_sigma_m_s2 = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> accel_bias_per_pose_m_s2;  ///< b_a per pose (it walks)
+  bool accel_bias_estimated = false;
+  Eigen::Matrix3d soft_iron = Eigen::Matrix3d::Identity();  ///< S_m
+  Eigen::Matrix3d soft_iron_sigma = Eigen::Matrix3d::Zero();
+  bool soft_iron_estimated = false;
+  Eigen::Vector3d hard_iron_t = Eigen::Vector3d::Zero();
+  Eigen::Vector3d hard_iron_sigma_t = Eigen::Vector3d::Zero();
+  bool hard_iron_estimated = false;
+  bool magnetometer_used = false;
+  double magnetic_field_t = 0;  ///< |m_world| (T), when the magnetometer is used
+  double magnetic_dip_rad = 0;  ///< dip (rad, positive downwards), when used
+};
+
+struct JointResult {
+  bool ok = false;
+  std::string message;  ///< why not, when !ok; a summary otherwise
+  Eigen::Matrix3d R_cam_imu = Eigen::Matrix3d::Identity();
+  /// Covariance of the left perturbation R_cam_imu <- Exp(e) R_cam_imu (rad^2, camera axes),
+  /// scaled by chi2 / dof when that is > 1 (covariance_scale).
+  Eigen::Matrix3d covariance_rad2 = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d std_dev_deg = Eigen::Vector3d::Zero();  ///< camera x, y, z axes
+  double covariance_scale = 1.0;  ///< chi2 / dof applied to every covariance (1 when <= 1)
+  /// With JointProblem::mount_change_pose: R_cam_imu of the poses from that index on (R_cam_imu
+  /// is then the earlier poses').
+  std::optional<Eigen::Matrix3d> R_cam_imu_after_change;
+  Eigen::Matrix3d R_world_target =
+      Eigen::Matrix3d::Identity();  ///< W's yaw: gauge w/o magnetometer
+  ImuIntrinsics intrinsics;
+  std::vector<EstimatedValue> parameters;  ///< every IMU parameter block, estimated or held
+  /// Consistency: chi2 = sum of squared whitened residuals (priors included, no robust loss),
+  /// dof = residuals - free parameters, p-value of chi2 given dof.
+  double chi2 = 0;
+  int dof = 0;
+  double chi2_p_value = 1;
+  /// Per pose: RMS whitened residual (sigma units) over its camera, accelerometer, magnetometer and
+  /// gyro-bias residuals and half of each adjacent gyro residual.
+  std::vector<double> pose_residual_norm;
+  /// Per pose: the magnetometer residual's squared whitened norm (chi-square with 3 dof when the
+  /// model holds; robust loss not applied), 0 where the field is not used.
+  std::vector<double> mag_residual_chi2;
+  /// Poses whose field was left out as disturbed: it did not fit the calibrated iron and field.
+  std::vector<int> mag_poses_left_out;
+  int iterations = 0;        ///< Levenberg-Marquardt iterations over all passes
+  int relinearisations = 0;  ///< gyro preintegration passes
+  /// The model of T_g and T_a this result is of: kEstimate or kIdentity (kSelect chooses one).
+  ImuMatrixModel imu_matrices = ImuMatrixModel::kEstimate;
+  double solve_time_s = 0;
+  std::vector<std::string> notes;  ///< what was not estimated and why, what to rotate about
+  /// Unit vector (IMU frame): the rotation axis that would add the most information.
+  Eigen::Vector3d suggested_rotation_axis_imu = Eigen::Vector3d::UnitX();
+};
+
+}  // namespace camera_imu_alignment
