@@ -113,7 +113,7 @@ TEST(OnlineCalibrator, BroadcastsWithinATenthOfADegreeForEachGrade) {
     EXPECT_EQ(c.state(), CalibrationState::kCalibrated) << c.stateMessage();
     EXPECT_LT(errorDeg(c.broadcast()->R_cam_imu, run->simulated->trajectory.R_cam_imu_final()), 0.2)
         << toString(grade);
-    EXPECT_EQ(c.remounts(), 0) << toString(grade);
+    EXPECT_EQ(c.snapshot().remounts, 0) << toString(grade);
     // What is broadcast carries its own quality: the poses and 1-sigma of that estimate.
     const BroadcastEstimate& b = run->recorder.broadcasts.back();
     ASSERT_TRUE(b.result.has_value());
@@ -274,7 +274,7 @@ TEST(OnlineCalibrator, ANewestPoseThatLooksLikeARemountIsNotBroadcast) {
     ASSERT_TRUE(calibrator.lastEstimate().has_value()) << what;
     const EstimateEvent& last = *calibrator.lastEstimate();
     ASSERT_TRUE(last.mount_test.has_value()) << what;
-    EXPECT_EQ(calibrator.remounts(), 0) << what;
+    EXPECT_EQ(calibrator.snapshot().remounts, 0) << what;
     if (!last.mount_test->pending) continue;
     ++pending;
     EXPECT_EQ(last.mount_test->first_pose_kept, static_cast<int>(last.window_poses) - 1) << what;
@@ -321,8 +321,8 @@ TEST(OnlineCalibrator, NoFalseRemountOnUnchangedRecordings) {
                               sim::ImuGrade::kConsumer, sim::ImuGrade::kNoisy}) {
     for (std::uint64_t seed = 1; seed <= 20; ++seed) {
       const auto run = calibrate(configFor(grade, 80 + seed), synchronous());
-      remounts += run->calibrator->remounts();
-      EXPECT_EQ(run->calibrator->remounts(), 0)
+      remounts += run->calibrator->snapshot().remounts;
+      EXPECT_EQ(run->calibrator->snapshot().remounts, 0)
           << toString(grade) << " seed " << seed << ": " << run->calibrator->stateMessage();
     }
   }
@@ -335,25 +335,25 @@ TEST(OnlineCalibrator, ResetForgetsTheWindowAndKeepsTheBroadcast) {
   ASSERT_TRUE(c.broadcast().has_value());
   const Eigen::Matrix3d broadcast = c.broadcast()->R_cam_imu;
   c.reset();
-  EXPECT_EQ(c.pipeline().windowSize(), 0u);
-  EXPECT_EQ(c.pipeline().posesTotal(), 0u);
+  EXPECT_EQ(c.snapshot().window.size(), 0u);
+  EXPECT_EQ(c.snapshot().poses_total, 0u);
   EXPECT_FALSE(c.lastEstimate().has_value());
   EXPECT_EQ(c.state(), CalibrationState::kCollecting);
   EXPECT_NE(c.stateMessage().find("reset"), std::string::npos);
   ASSERT_TRUE(c.broadcast().has_value());
   EXPECT_TRUE(c.broadcast()->R_cam_imu.isApprox(broadcast));
-  EXPECT_EQ(c.remounts(), 0);
+  EXPECT_EQ(c.snapshot().remounts, 0);
 }
 
 TEST(OnlineCalibrator, AClockJumpBackClearsTheWindowAndKeepsTheBroadcast) {
   const auto run = calibrate(configFor(sim::ImuGrade::kIdeal, 44), synchronous());
   OnlineCalibrator& c = *run->calibrator;
   ASSERT_TRUE(c.broadcast().has_value());
-  ASSERT_GT(c.pipeline().windowSize(), 0u);
+  ASSERT_GT(c.snapshot().window.size(), 0u);
   c.addImu({1.0, Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 9.81)});  // a bag loop
   ASSERT_EQ(run->recorder.clock_jumps.size(), 1u);
   EXPECT_GT(run->recorder.clock_jumps[0], 10.0);
-  EXPECT_EQ(c.pipeline().windowSize(), 0u);
+  EXPECT_EQ(c.snapshot().window.size(), 0u);
   EXPECT_TRUE(c.broadcast().has_value());
 }
 

@@ -197,6 +197,7 @@ TEST(ReportFigures, JointResidualsPerPoseComeFromTheJointEstimateOfTheWindow) {
   joint.chi2 = 153.0;
   joint.dof = 150;
   joint.chi2_p_value = 0.42;
+  joint.ok = true;
   in.result.joint = joint;
   const ReportFigures figures = reportFigures(in);
   ASSERT_EQ(figures.poses.size(), 6u);
@@ -205,6 +206,7 @@ TEST(ReportFigures, JointResidualsPerPoseComeFromTheJointEstimateOfTheWindow) {
   }
   EXPECT_EQ(jointConsistencyText(joint), "chi2/dof 1.02 (150 dof, p 0.420: consistent)");
   joint.chi2_p_value = 0.001;
+  joint.consistency_level = 0.01;  // the level the gate judged it at (consistency_level)
   EXPECT_EQ(jointConsistencyText(joint), "chi2/dof 1.02 (150 dof, p 0.001: INCONSISTENT)");
   // A joint estimate over another number of poses than the window is not matched to poses.
   in.result.joint->pose_residual_norm.pop_back();

@@ -53,7 +53,17 @@ std::string AlignmentWrapper::Impl::imuFrame() const {
 }
 
 void AlignmentWrapper::Impl::onBroadcast(const BroadcastEstimate& estimate) {
-  sendTransform(estimate.R_cam_imu);
+  // A refined estimate (within min_change_deg) keeps the tf: only the file changes.
+  const bool refined = sent_R_cam_imu && sent_R_cam_imu->isApprox(estimate.R_cam_imu, 1e-12);
+  if (refined) {
+    ROS_INFO(
+        "%s: the tf stays; the saved calibration becomes the %d-pose estimate (1-sigma %.4f "
+        "deg)",
+        name.c_str(), estimate.poses, estimate.maxStdDevDeg());
+  } else {
+    sendTransform(estimate.R_cam_imu);
+    sent_R_cam_imu = estimate.R_cam_imu;
+  }
   if (estimate.source != "estimated" || settings.output_file.empty()) {
     publishStatus();
     return;
@@ -128,30 +138,29 @@ void AlignmentWrapper::Impl::loadSaved() {
 }
 
 void AlignmentWrapper::Impl::publishStatus() {
+  const CalibrationSnapshot snap = calibrator->snapshot();
   AlignmentStatus s;
-  const double newest = calibrator->newestStamp();
-  s.header.stamp = newest > 0.0 ? ros::Time(newest) : ros::Time::now();
+  s.header.stamp = snap.newest_stamp_s > 0 ? ros::Time(snap.newest_stamp_s) : ros::Time::now();
   s.header.frame_id = cameraFrame();
-  const CalibrationPipeline& pipeline = calibrator->pipeline();
-  s.state = toString(calibrator->state());
-  s.message = calibrator->stateMessage();
-  if (calibrator->state() == CalibrationState::kWaitingForData) {
-    if (pipeline.imuSamples() == 0) {
+  s.state = toString(snap.state);
+  s.message = snap.message;
+  if (snap.state == CalibrationState::kWaitingForData) {
+    if (snap.inputs.imu_samples == 0) {
       s.message = "waiting for IMU data on " + imu_sub.getTopic();
     } else {
       s.message = "waiting for the camera: nothing on " + topicOf(InputStream::kImage) + " / " +
                   topicOf(InputStream::kCameraInfo) + " / " + camera_pose_sub.getTopic() + " yet";
     }
   }
-  s.poses_in_window = static_cast<std::uint32_t>(pipeline.windowSize());
-  s.poses_total = static_cast<std::uint32_t>(pipeline.posesTotal());
-  s.rests_total = static_cast<std::uint32_t>(pipeline.restsTotal());
-  s.remounts = static_cast<std::uint32_t>(calibrator->remounts());
+  s.poses_in_window = static_cast<std::uint32_t>(snap.window.size());
+  s.poses_total = static_cast<std::uint32_t>(snap.poses_total);
+  s.rests_total = static_cast<std::uint32_t>(snap.rests_total);
+  s.remounts = static_cast<std::uint32_t>(snap.remounts);
   s.q_cam_imu.w = 1.0;
   s.q_broadcast.w = 1.0;
-  const std::optional<BroadcastEstimate>& broadcast = calibrator->broadcast();
-  if (const std::optional<EstimateEvent>& e = calibrator->lastEstimate()) {
-    const AlignmentResult& r = e->result;
+  const std::optional<BroadcastEstimate>& broadcast = snap.broadcast;
+  if (snap.latest) {
+    const AlignmentResult& r = snap.latest->result;
     s.pairs = static_cast<std::uint32_t>(r.quality.num_pairs);
     s.inliers = static_cast<std::uint32_t>(r.quality.num_inliers);
     s.has_estimate = true;
@@ -159,20 +168,19 @@ void AlignmentWrapper::Impl::publishStatus() {
     s.residual_rms_deg = r.quality.residual_rms_deg;
     for (int i = 0; i < 3; ++i) s.std_dev_deg[i] = r.quality.std_dev_deg(i);
     s.observability = r.quality.observability;
-    s.broadcast =
-        broadcast && rad2deg(rotationAngle(broadcast->R_cam_imu.transpose() * r.R_cam_imu)) <= 1e-9;
+    s.broadcast = snap.latest_is_broadcast;
     if (r.joint && r.joint->ok) {
-      s.consistent = r.joint->chi2_p_value >= settings.online.consistency_level;
+      s.consistent = snap.latest->gate.consistent;
       s.chi2 = r.joint->chi2;
       s.dof = static_cast<std::uint32_t>(std::max(0, r.joint->dof));
       s.p_value = r.joint->chi2_p_value;
     }
   }
-  const Eigen::Vector3d axis = calibrator->rotateAboutCam();
+  const Eigen::Vector3d axis = snap.progress.rotate_about_cam;
   s.rotate_about_cam.x = axis.x();
   s.rotate_about_cam.y = axis.y();
   s.rotate_about_cam.z = axis.z();
-  s.imu_guidance = calibrator->imuGuidance();
+  s.imu_guidance = snap.progress.imu_guidance;
   if (!s.imu_guidance.empty()) s.message += "; " + s.imu_guidance;
   if (broadcast) {
     s.has_broadcast = true;
@@ -181,7 +189,7 @@ void AlignmentWrapper::Impl::publishStatus() {
     s.broadcast_source = broadcast->source;
     s.broadcast_poses = static_cast<std::uint32_t>(broadcast->poses);
   }
-  if (const std::optional<StationaryPose>& last = calibrator->lastPose()) {
+  if (const std::optional<StationaryPose>& last = snap.last_pose) {
     s.last_pose_start = ros::Time(last->start_s);
     s.last_pose_end = ros::Time(last->end_s);
     s.last_pose_frames = static_cast<std::uint32_t>(last->num_frames);
@@ -193,14 +201,10 @@ void AlignmentWrapper::Impl::publishStatus() {
 void AlignmentWrapper::Impl::publishPoses() {
   // Camera orientations at the poses, in the target frame (rviz: fixed frame = the target).
   geometry_msgs::PoseArray out;
-  out.header.stamp = ros::Time(std::max(calibrator->newestStamp(), 0.0));
-  const CalibrationPipeline& pipeline = calibrator->pipeline();
+  const CalibrationSnapshot snap = calibrator->snapshot();
+  out.header.stamp = ros::Time(std::max(snap.newest_stamp_s, 0.0));
   out.header.frame_id = "calibration_target";
-  // The poses in the sliding window: the newest windowSize() of the history.
-  const std::vector<StationaryPose>& history = pipeline.poses();
-  const std::size_t first = history.size() - std::min(history.size(), pipeline.windowSize());
-  for (std::size_t i = first; i < history.size(); ++i) {
-    const StationaryPose& p = history[i];
+  for (const StationaryPose& p : snap.window) {
     geometry_msgs::Pose pose;
     pose.position.x = p.p_target_cam.x();
     pose.position.y = p.p_target_cam.y();
@@ -209,9 +213,9 @@ void AlignmentWrapper::Impl::publishPoses() {
     out.poses.push_back(pose);
   }
   poses_pub.publish(out);
-  if (pipeline.poses().empty()) return;
+  if (snap.poses.empty()) return;
   // The target seen from the camera at the last pose: R_cam_target = R_target_cam^T.
-  const StationaryPose& last = pipeline.poses().back();
+  const StationaryPose& last = snap.poses.back();
   geometry_msgs::PoseStamped target;
   target.header.stamp = ros::Time(last.end_s);
   target.header.frame_id = cameraFrame();
@@ -331,23 +335,23 @@ bool AlignmentWrapper::Impl::onCapturePose(std_srvs::Trigger::Request&,
 
 void AlignmentWrapper::Impl::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   using diagnostic_msgs::DiagnosticStatus;
-  const CalibrationPipeline& pipeline = calibrator->pipeline();
-  const CalibrationState state = calibrator->state();
+  const CalibrationSnapshot snap = calibrator->snapshot();
+  const CalibrationState state = snap.state;
   std::vector<std::string> problems;  // each makes the summary WARN
   if (state == CalibrationState::kNotObservable || state == CalibrationState::kRecalibrating) {
-    problems.push_back(calibrator->stateMessage());
+    problems.push_back(snap.message);
   }
   for (InputStream stream : silentStreams()) {
     problems.push_back("nothing on " + topicOf(stream) + " while other inputs flow");
   }
-  const std::uint64_t not_found = pipeline.rejections().count(RejectReason::kTargetNotFound);
-  if (pipeline.framesDetected() >= 10 && not_found >= pipeline.framesDetected()) {
+  const std::uint64_t not_found = snap.rejections.count(RejectReason::kTargetNotFound);
+  if (snap.inputs.frames_detected >= 10 && not_found >= snap.inputs.frames_detected) {
     problems.push_back("the target was not found in any of " +
-                       std::to_string(pipeline.framesDetected()) +
+                       std::to_string(snap.inputs.frames_detected) +
                        " frames at rest: does target_file describe the board in view?");
   }
   if (!save_error.empty()) problems.push_back(save_error);
-  std::string summary = std::string(toString(state)) + ": " + calibrator->stateMessage();
+  std::string summary = std::string(toString(state)) + ": " + snap.message;
   for (const std::string& p : problems) {
     if (summary.find(p) == std::string::npos) summary += "; " + p;
   }
@@ -359,15 +363,15 @@ void AlignmentWrapper::Impl::diagnose(diagnostic_updater::DiagnosticStatusWrappe
   status.add("magnetometer rate (Hz)", mag_count / elapsed);
   status.add("image rate (Hz)", image_count / elapsed);
   imu_count = mag_count = image_count = 0;
-  status.add("imu samples", pipeline.imuSamples());
-  status.add("magnetometer samples", pipeline.magneticSamples());
-  status.add("frames", pipeline.frames());
-  status.add("frames detected", pipeline.framesDetected());
-  status.add("poses in window", pipeline.windowSize());
-  status.add("remounts", calibrator->remounts());
-  status.add("imu gaps", pipeline.imuGaps());
+  status.add("imu samples", snap.inputs.imu_samples);
+  status.add("magnetometer samples", snap.inputs.magnetic_samples);
+  status.add("frames", snap.inputs.frames);
+  status.add("frames detected", snap.inputs.frames_detected);
+  status.add("poses in window", snap.window.size());
+  status.add("remounts", snap.remounts);
+  status.add("imu gaps", snap.inputs.imu_gaps);
   // One key per reason, zeros included, so that monitors can track each.
-  const RejectionCounts& rejections = pipeline.rejections();
+  const RejectionCounts& rejections = snap.rejections;
   status.add("rejected inputs", rejections.summary());
   for (int i = 0; i < static_cast<int>(RejectReason::kCount); ++i) {
     const auto reason = static_cast<RejectReason>(i);

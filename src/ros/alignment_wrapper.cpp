@@ -135,7 +135,7 @@ void AlignmentWrapper::Impl::warnSilentStreams() {
   }
   // A 6-axis IMU has no magnetometer: said once, not warned about.
   if (!mag_absence_noted && !streams.everSeen(InputStream::kMagnetometer) &&
-      calibrator->pipeline().imuSamples() > 2000) {
+      calibrator->inputCounts().imu_samples > 2000) {
     mag_absence_noted = true;
     ROS_WARN(
         "%s: nothing on %s while the IMU flows: the magnetometer is not used (fine for a 6-axis "
@@ -152,7 +152,7 @@ void AlignmentWrapper::Impl::onImu(const sensor_msgs::ImuConstPtr& msg) {
   input_stopped = false;
   ++imu_count;
   input->addImu(*msg);
-  const std::uint64_t gaps = calibrator->pipeline().imuGaps();
+  const std::uint64_t gaps = calibrator->inputCounts().imu_gaps;
   if (gaps != imu_gaps_warned) {  // differs also after a reset clearing counts
     imu_gaps_warned = gaps;
     if (gaps > 0) {
@@ -231,8 +231,14 @@ void AlignmentWrapper::Impl::onPoseRejected(const RejectedPose& rejected) {
 }
 
 void AlignmentWrapper::Impl::onEstimate(const EstimateEvent& event) {
+  const CalibrationProgress progress = progressOf(event, settings.online.max_std_dev_deg);
+  ROS_INFO("%s: estimate from %zu poses: %s", name.c_str(), event.window_poses,
+           progressText(progress).c_str());
   if (event.gate.decision == GateDecision::kReject) {
     ROS_INFO_THROTTLE(2.0, "%s: estimate not broadcast: %s", name.c_str(), event.gate.why.c_str());
+  } else if (event.gate.decision == GateDecision::kKeep) {
+    ROS_INFO_THROTTLE(2.0, "%s: estimate kept back, the tf stays: %s", name.c_str(),
+                      event.gate.why.c_str());
   }
   publishStatus();
 }

@@ -125,6 +125,7 @@ struct AlignmentWrapper::Impl {
   void sendTransform(const Eigen::Matrix3d& R_cam_imu);
   /// Writes the broadcast estimate with its own quality (poses behind it, 1-sigma) to output_file.
   bool save(const BroadcastEstimate& estimate, std::string* error);
+  std::optional<Eigen::Matrix3d> sent_R_cam_imu;  ///< what the static tf says (none before)
   std::string save_error;  ///< why the last save failed ("" after a good one): diagnostics
   void loadSaved();
   void publishStatus();

@@ -27,18 +27,18 @@ BagProgress::BagProgress(bool enabled, double start_s, double end_s)
     : enabled_(enabled), tty_(isatty(fileno(stderr))), start_(start_s), end_(end_s) {}
 
 void BagProgress::update(double t, const OnlineCalibrator& calibrator, bool force) {
-  const CalibrationPipeline& pipeline = calibrator.pipeline();
   if (!enabled_) return;
   const double span = end_ - start_;
   const int percent = span > 0.0 ? static_cast<int>(100.0 * (t - start_) / span) : 100;
   const int step = tty_ ? 1 : 10;
   if (!force && percent / step == last_ / step) return;
   last_ = percent;
+  const CalibrationSnapshot snap = calibrator.snapshot();
   std::ostringstream line;
   line << "[calibrate_bag] " << std::setw(3) << std::min(percent, 100) << "% of bag time, "
-       << pipeline.segments().size() << " rests, " << pipeline.poses().size() << " poses";
-  if (const auto& estimate = calibrator.lastEstimate()) {
-    const AlignmentResult& result = estimate->result;
+       << snap.rests.size() << " rests, " << snap.poses.size() << " poses";
+  if (snap.latest) {
+    const AlignmentResult& result = snap.latest->result;
     line << ", R_cam_imu " << rollPitchYawText(result.R_cam_imu, 2) << " +- " << std::fixed
          << std::setprecision(2) << result.quality.std_dev_deg.maxCoeff();
   }

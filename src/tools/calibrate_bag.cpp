@@ -108,23 +108,6 @@ bool writeImuYaml(const std::string& path, const cia::ReportInput& report,
   return true;
 }
 
-/// The poses of the pipeline's window (those the estimate used), as the poses CSV holds them: the
-/// stamp in the middle of the rest, as the window itself pairs them.
-std::vector<cia::PoseOrientation> windowPoses(const cia::CalibrationPipeline& pipeline) {
-  const std::vector<cia::StationaryPose>& history = pipeline.poses();
-  const std::size_t first = history.size() - std::min(history.size(), pipeline.windowSize());
-  std::vector<cia::PoseOrientation> poses;
-  for (std::size_t i = first; i < history.size(); ++i) {
-    cia::PoseOrientation pose;
-    pose.stamp_s = 0.5 * (history[i].start_s + history[i].end_s);
-    pose.R_target_cam = history[i].R_target_cam;
-    pose.R_world_imu = history[i].R_world_imu;
-    pose.group = history[i].group;
-    poses.push_back(pose);
-  }
-  return poses;
-}
-
 /// The whole job; returns the exit code.
 int run(const cia::CliArgs& args) {
   // --- Inputs: target, settings, bag, topics. Each failure names its file, option or topic.
@@ -186,12 +169,10 @@ int run(const cia::CliArgs& args) {
   // --- Run the pipeline over the bag.
   // The nodelet's calibrator (poses, solves, change detection, gates), solving as poses arrive.
   cia::BagRejectLog reject_log(topics);
-  std::vector<cia::RemountEvent> remounts;
   cia::OnlineCallbacks callbacks;
   callbacks.on_reject = [&](cia::RejectReason r, cia::InputStream stream, const std::string& d) {
     reject_log(r, stream, d);
   };
-  callbacks.on_remount = [&](const cia::RemountEvent& e) { remounts.push_back(e); };
   online.threaded = false;
   std::unique_ptr<cia::OnlineCalibrator> calibrator;
   try {
@@ -200,7 +181,6 @@ int run(const cia::CliArgs& args) {
     std::cerr << "calibrate_bag: " << e.what() << "\n";
     return kExitBadInput;
   }
-  const cia::CalibrationPipeline& pipeline = calibrator->pipeline();
   cia::BagProgress progress(!args.has("--quiet"), info.start_s, info.end_s);
   try {
     readBag(bag, topics, calibrator.get(), &progress, &info);
@@ -212,16 +192,18 @@ int run(const cia::CliArgs& args) {
   }
 
   // --- Verdict.
-  std::cerr << "[calibrate_bag] read " << pipeline.imuSamples() << " IMU, "
-            << pipeline.magneticSamples() << " magnetometer samples, " << info.image_messages
-            << " images; " << pipeline.segments().size() << " stationary rests, "
-            << pipeline.poses().size() << " poses\n";
+  const cia::CalibrateOutcome outcome = calibrator->calibrateNow(false);
+  const cia::CalibrationSnapshot snap = calibrator->snapshot();
+  std::cerr << "[calibrate_bag] read " << snap.inputs.imu_samples << " IMU, "
+            << snap.inputs.magnetic_samples << " magnetometer samples, " << info.image_messages
+            << " images; " << snap.rests.size() << " stationary rests, " << snap.poses.size()
+            << " poses\n";
   if (topics.image.empty() || info.image_messages == 0) {
     std::cerr << "calibrate_bag: " << bag_path << ": no camera data (no sensor_msgs/Image or "
               << "CompressedImage messages); the IMU alone cannot give R_cam_imu\n";
     return kExitBadInput;
   }
-  if (!pipeline.hasIntrinsics()) {
+  if (!snap.inputs.has_intrinsics) {
     std::cerr << "calibrate_bag: " << bag_path << ": no usable camera info ("
               << (topics.camera_info.empty() ? "no sensor_msgs/CameraInfo topic"
                                              : topics.camera_info)
@@ -229,41 +211,29 @@ int run(const cia::CliArgs& args) {
     return kExitBadInput;
   }
   cia::ReportInput report;
-  const cia::CalibrateOutcome outcome = calibrator->calibrateNow(false);
   report.result = outcome.result;
-  report.poses = pipeline.poses();
-  report.rejected = pipeline.rejectedPoses();
-  report.segments = pipeline.segments();
-  report.rejections = pipeline.rejections();
+  report.poses = snap.poses;
+  report.rejected = snap.rejected_poses;
+  report.segments = snap.rests;
+  report.rejections = snap.rejections;
   report.start_s = info.start_s;
   report.end_s = info.end_s;
   report.camera_frame = cia::frameOr(info.camera_frame, cia::kDefaultCameraFrame);
   report.imu_frame = cia::frameOr(info.imu_frame, cia::kDefaultImuFrame);
   report.source = bag_path;
-  report.pairs = pipeline.windowPairs();
-  report.window_poses = pipeline.windowSize();
+  report.pairs = cia::makeAllPairs(snap.windowOrientations());
+  report.window_poses = snap.window.size();
   if (truth) report.truth = cia::KnownTruth{truth->R_cam_imu, args.get("--truth")};
-  // The nodelet's verdict: a remount during the recording, a failed quality gate.
-  const bool gates_passed = outcome.gate.decision != cia::GateDecision::kReject && remounts.empty();
-  if (report.result.status == cia::SolveStatus::kOk) {
-    std::string text = "PASSED (the nodelet would broadcast it)";
-    if (!remounts.empty()) {
-      text = "FAILED: the mount changed during the recording (first before pose " +
-             std::to_string(remounts.front().first_pose_index) +
-             "); the estimate is of the last mount, from the poses after the change";
-      if (outcome.gate.decision == cia::GateDecision::kReject) text += "; and " + outcome.gate.why;
-    } else if (!gates_passed) {
-      text = "FAILED: " + outcome.gate.why;
-    }
-    report.verdict = cia::ReportVerdict{gates_passed, text};
-  }
+  // The nodelet's verdict (decided in the core): a remount during the recording, a failed gate.
+  const bool gates_passed = outcome.verdict && outcome.verdict->passed;
+  if (outcome.verdict) report.verdict = cia::ReportVerdict{gates_passed, outcome.verdict->text};
   std::cout << cia::formatSummary(report);
   if (truth) {
     std::cout << std::fixed << std::setprecision(4) << "error to " << args.get("--truth") << ": "
               << cia::rad2deg(cia::geodesicDistance(report.result.R_cam_imu, truth->R_cam_imu))
               << " deg\n";
   }
-  for (const cia::RemountEvent& e : remounts) {
+  for (const cia::RemountEvent& e : snap.remount_events) {
     std::cout << "remount: " << e.message << "\n";
   }
   if (args.has("--report")) {
@@ -275,7 +245,7 @@ int run(const cia::CliArgs& args) {
   }
   if (args.has("--export-poses")) {
     try {
-      cia::writePosesCsv(args.get("--export-poses"), windowPoses(pipeline));
+      cia::writePosesCsv(args.get("--export-poses"), snap.windowOrientations());
     } catch (const cia::InputError& e) {
       std::cerr << "calibrate_bag: --export-poses " << e.what() << "\n";
       return kExitBadInput;

@@ -9,9 +9,6 @@
 
 namespace camera_imu_alignment {
 
-/// Significance level of the chi-square consistency test reported as `consistent`.
-inline constexpr double kConsistencyLevel = 0.01;
-
 /// The two blocks as YAML text (top level, no trailing blank line).
 std::string jointToYaml(const JointResult& joint);
 

@@ -22,6 +22,15 @@ const char* toString(GateDecision decision);
 struct GateOutcome {
   GateDecision decision = GateDecision::kReject;
   std::string why;  ///< for kReject and kKeep: the gate, with its numbers and parameter
+  /// The verdicts every output prints (status, YAML, report, calibrate_bag), decided here once:
+  /// consistent: a joint estimate that succeeded with chi-square p >= consistency_level (pair
+  /// modes: always false, they have no such test);
+  bool consistent = false;
+  /// determined: solved, observable and finite with its largest 1-sigma <= max_std_dev_deg.
+  bool determined = false;
+  /// kKeep within min_change_deg, with a smaller 1-sigma than the broadcast estimate's: the tf
+  /// stays, but the saved file and the broadcast 1-sigma become this estimate's.
+  bool refines_broadcast = false;
 };
 
 /// The gates in order:
@@ -36,7 +45,8 @@ struct GateOutcome {
 ///     a reference) or it differs significantly from the broadcast one (the mount changed while
 ///     nothing was watching: their difference is judged against both covariances at
 ///     remount.level);
-///   min_change_deg: a change smaller than that is not re-broadcast.
+///   min_change_deg: a change smaller than that is not re-broadcast (refines_broadcast when it is
+///     more precise).
 GateOutcome judgeEstimate(const AlignmentResult& result, std::size_t window_poses,
                           const OnlineSettings& settings,
                           const std::optional<BroadcastEstimate>& broadcast, bool fresh_start);

@@ -31,32 +31,13 @@
 #include <string>
 
 #include "camera_imu_alignment/online/broadcast_gate.h"
+#include "camera_imu_alignment/online/calibration_snapshot.h"
 #include "camera_imu_alignment/online/clock_jump.h"
 #include "camera_imu_alignment/online/online_types.h"
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
 #include "camera_imu_alignment/pipeline/sample_sink.h"
 
 namespace camera_imu_alignment {
-
-/// A solve of the window and what the gates made of it.
-struct EstimateEvent {
-  AlignmentResult result;
-  GateOutcome gate;
-  std::size_t window_poses = 0;  ///< poses the estimate used
-  bool forced = false;           ///< broadcast on request although a gate failed
-  std::optional<MountChangeTest> mount_test;
-};
-
-/// A mount change found.
-struct RemountEvent {
-  int first_pose_index = 0;  ///< StationaryPose::index of the first pose of the new mount
-  /// The window restarted from this pose (>= first_pose_index: a later split fitted as well, and
-  /// an old-mount pose would bias the new estimate).
-  int first_pose_kept = 0;
-  double change_deg = 0;       ///< between the two mounts' estimates (0 when unknown: pair modes)
-  std::size_t poses_kept = 0;  ///< poses of the new mount left in the window
-  std::string message;
-};
 
 struct OnlineCallbacks {
   std::function<void(const StationaryPose&)> on_pose;
@@ -79,6 +60,8 @@ struct CalibrateOutcome {
   bool broadcast = false;            ///< it is now what the tf says
   std::string not_broadcast_reason;  ///< "" when broadcast
   std::size_t window_poses = 0;
+  /// The recording's verdict on this estimate (recordingVerdict; none when not solved).
+  std::optional<CalibrationVerdict> verdict;
 };
 
 class OnlineCalibrator : public SampleSink {
@@ -121,18 +104,15 @@ class OnlineCalibrator : public SampleSink {
   const std::string& stateMessage() const;
   const std::optional<EstimateEvent>& lastEstimate() const;
   const std::optional<BroadcastEstimate>& broadcast() const;
-  const std::optional<StationaryPose>& lastPose() const;
-  int remounts() const;
-  /// Which rotation would most improve the IMU parameters still held at their priors ("" when
-  /// nothing is held or there is no joint estimate).
-  std::string imuGuidance() const;
-  /// The camera axis to rotate about next: the pair solve's least excited axis while R_cam_imu is
-  /// not determined, else the axis that would calibrate the held IMU parameters.
-  Eigen::Vector3d rotateAboutCam() const;
   /// Newest stamp on any input (s), -1 before the first.
   double newestStamp() const;
-  const CalibrationPipeline& pipeline() const;
   const OnlineSettings& settings() const;
+  /// Everything the outputs show, as one value (calibration_snapshot.h). Copies the pose
+  /// histories (at most CalibrationPipeline::kHistoryLimit each): call it per output, not per
+  /// sample.
+  CalibrationSnapshot snapshot() const;
+  /// The input counters alone (cheap: per sample).
+  InputCounts inputCounts() const;
 
  private:
   struct Impl;

@@ -32,7 +32,7 @@ struct OnlineSettings {
   /// Chi-square test of the joint estimate: its p-value must be at least this (probability of
   /// refusing a correct estimate); a smaller p means the data do not fit one mount with the
   /// modelled noise.
-  double consistency_level = 1e-3;
+  double consistency_level = kDefaultConsistencyLevel;
   /// Pair modes only (imu_orientation auto or message; the joint modes have the chi-square test):
   /// the RMS pair residual (deg) a broadcast estimate may have.
   double max_residual_deg = 1.0;
@@ -50,8 +50,10 @@ struct OnlineSettings {
   std::string validate() const;
 };
 
-/// What the static tf says.
+/// What the static tf says, and what is saved.
 struct BroadcastEstimate {
+  /// What the tf says. Within min_change_deg of `result`'s: a more precise estimate that moved
+  /// less than that refines the saved file and the 1-sigma, not the tf.
   Eigen::Matrix3d R_cam_imu = Eigen::Matrix3d::Identity();
   /// 1-sigma about the camera axes (deg); infinite when unknown (a file without it).
   Eigen::Vector3d std_dev_deg = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
@@ -60,7 +62,8 @@ struct BroadcastEstimate {
   std::optional<Eigen::Matrix3d> covariance_rad2;
   int poses = 0;       ///< poses behind it
   std::string source;  ///< "estimated" (this run) or "loaded: <file>"
-  /// The estimate itself when estimated here: what is saved.
+  /// The best estimate that passed the gates, when estimated here: what is saved (its
+  /// std_dev_deg, covariance and poses are the fields above).
   std::optional<AlignmentResult> result;
   double maxStdDevDeg() const { return std_dev_deg.maxCoeff(); }
 };

@@ -8,7 +8,7 @@
 //   camera frames -> queued until the IMU shows whether the frame time is at rest; detection + PnP
 //     only on frames at rest (never while moving), at most max_frames_per_pose per pose
 //   segment end -> StationaryPose (camera: robust average of the frame orientations; IMU: see
-//     below) -> PoseWindow -> solveAlignment -> callbacks.
+//     below) -> StationaryWindow -> solveAlignment -> callbacks.
 //
 // R_cam_imu (PipelineSettings::imu_orientation):
 //   kJoint (default): one maximum-likelihood estimate over the window's poses from every sensor
@@ -142,7 +142,7 @@ struct RejectedPose {
 /// A copy of the window, to be solved away from the pipeline (solveWindow), e.g. on a worker
 /// thread while samples keep arriving.
 struct WindowSnapshot {
-  RotationPairs pairs;  ///< PoseWindow::makePairs
+  RotationPairs pairs;  ///< StationaryWindow::pairs
   JointProblem joint;   ///< the joint estimator's problem (imu_orientation: joint or magnetometer)
   std::vector<int> pose_indices;  ///< StationaryPose::index of each window pose, oldest first
 };
@@ -204,6 +204,9 @@ class CalibrationPipeline : public SampleSink {
   /// index, which stays valid while newer poses arrive).
   void keepPosesFrom(int pose_index);
   std::size_t windowSize() const;  ///< poses in the solver's window
+  /// The poses in the solver's window, oldest first: the one answer to "which poses are in the
+  /// window" (the snapshot, the solve, a remount's restart, --export-poses all use it).
+  std::vector<StationaryPose> windowPoses() const;
 
   const std::vector<StationaryPose>& poses() const;  ///< the newest kHistoryLimit poses
   RotationPairs windowPairs() const;  ///< the pairs solve() uses (poses in the window)

@@ -13,6 +13,10 @@
 
 namespace camera_imu_alignment {
 
+/// Default significance level of the chi-square consistency test (the consistency_level setting,
+/// online/online_types.h).
+inline constexpr double kDefaultConsistencyLevel = 1e-3;
+
 enum class ImuMatrixModel {
   kEstimate,  ///< estimated, held by their priors (ImuModelPriors)
   kIdentity,  ///< held at I without uncertainty: a unit whose scale and axes are calibrated
@@ -77,6 +81,12 @@ struct JointResult {
   double chi2 = 0;
   int dof = 0;
   double chi2_p_value = 1;
+  /// The level the consistency verdict is judged at: the online calibrator stamps its
+  /// consistency_level setting here when its gate judges the estimate, so that the result YAML, the
+  /// report and the status print the gate's verdict (consistent()), never one of their own.
+  double consistency_level = kDefaultConsistencyLevel;
+  /// The chi-square test passed: ok and chi2_p_value >= consistency_level.
+  bool consistent() const { return ok && chi2_p_value >= consistency_level; }
   /// Per pose: RMS whitened residual (sigma units) over its camera, accelerometer, magnetometer and
   /// gyro-bias residuals and half of each adjacent gyro residual.
   std::vector<double> pose_residual_norm;

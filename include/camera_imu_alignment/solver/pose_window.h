@@ -1,9 +1,7 @@
-// Sliding window of stationary poses and the relative-rotation pairs formed from them.
+// Absolute orientations at stationary poses and the relative-rotation pairs formed from them.
 #pragma once
 
 #include <Eigen/Core>
-#include <cstddef>
-#include <deque>
 #include <vector>
 
 #include "camera_imu_alignment/solver/rotation_pair.h"
@@ -20,38 +18,13 @@ struct PoseOrientation {
   int group = 0;
 };
 
-/// Keeps the most recent `max_poses` stationary poses (the mount may drift: old poses leave the
-/// window) and forms pairs from them.
-///
-/// Pair choice: every pair (k, t), k < t, in the window (of the same group). Each pose then informs
-/// the estimate through all the others, large relative rotations are never skipped, and the result
-/// does not depend on pose order (consecutive-only pairs would waste the information between
-/// distant poses). Pairs share poses, so their noise is correlated; each pair carries its pose
-/// indices and the solver's covariance accounts for the correlation. Cost: P (P - 1) / 2 pairs, so
-/// the window is capped.
-class PoseWindow {
- public:
-  explicit PoseWindow(std::size_t max_poses = 30);
-
-  /// Adds a pose; drops the oldest when the window is full. Returns false (and ignores the pose)
-  /// when an orientation is not a finite rotation matrix.
-  bool add(const PoseOrientation& pose);
-  void clear();
-  /// Drops all but the newest `count` poses (a remount: the older ones describe the old mount).
-  void keepNewest(std::size_t count);
-  std::size_t size() const { return poses_.size(); }
-  std::size_t maxPoses() const { return max_poses_; }
-  const std::deque<PoseOrientation>& poses() const { return poses_; }
-
-  /// All pairs (k, t), k < t, of the poses in the window, with pose indices set.
-  RotationPairs makePairs() const;
-
- private:
-  std::size_t max_poses_;
-  std::deque<PoseOrientation> poses_;
-};
-
-/// All pairs (k, t), k < t, of `poses` within the same group (see PoseWindow).
+/// Pair choice: every pair (k, t), k < t, of the same group. Each pose then informs the estimate
+/// through all the others, large relative rotations are never skipped, and the result does not
+/// depend on pose order (consecutive-only pairs would waste the information between distant
+/// poses). Pairs share poses, so their noise is correlated; each pair carries its pose indices and
+/// the solver's covariance accounts for the correlation. Cost: P (P - 1) / 2 pairs, so the window
+/// (pipeline/stationary_window.h) is capped.
+/// All pairs (k, t), k < t, of `poses` within the same group, with pose indices set.
 RotationPairs makeAllPairs(const std::vector<PoseOrientation>& poses);
 
 }  // namespace camera_imu_alignment

@@ -1,6 +1,8 @@
 // Covariance, consistency and the reported IMU model of the joint estimator.
 #include <ceres/covariance.h>
 
+#include <boost/math/special_functions/gamma.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -14,36 +16,6 @@
 namespace camera_imu_alignment {
 namespace joint {
 namespace {
-
-/// Regularised upper incomplete gamma Q(a, x) (Numerical Recipes' series / continued fraction).
-double upperIncompleteGamma(double a, double x) {
-  if (!(x > 0.0)) return 1.0;
-  const double log_prefactor = -x + a * std::log(x) - std::lgamma(a);
-  if (x < a + 1.0) {
-    double term = 1.0 / a, sum = term;
-    for (int n = 1; n < 100000; ++n) {
-      term *= x / (a + n);
-      sum += term;
-      if (std::abs(term) < std::abs(sum) * 1e-15) break;
-    }
-    return std::clamp(1.0 - sum * std::exp(log_prefactor), 0.0, 1.0);
-  }
-  const double tiny = 1e-300;
-  double b = x + 1.0 - a, c = 1.0 / tiny, d = 1.0 / b, h = d;
-  for (int i = 1; i < 100000; ++i) {
-    const double an = -i * (i - a);
-    b += 2.0;
-    d = an * d + b;
-    if (std::abs(d) < tiny) d = tiny;
-    c = b + an / c;
-    if (std::abs(c) < tiny) c = tiny;
-    d = 1.0 / d;
-    const double delta = d * c;
-    h *= delta;
-    if (std::abs(delta - 1.0) < 1e-15) break;
-  }
-  return std::clamp(std::exp(log_prefactor) * h, 0.0, 1.0);
-}
 
 /// Sigmas (sqrt of the covariance diagonal, times sqrt(scale)) of `block`, or the priors' when
 /// the block was not requested (held).
@@ -84,7 +56,13 @@ Eigen::VectorXd toVector(const double* values, int size) {
 
 double chiSquareUpperTail(double chi2, int dof) {
   if (dof <= 0 || !std::isfinite(chi2)) return 1.0;
-  return upperIncompleteGamma(0.5 * dof, 0.5 * chi2);
+  if (!(chi2 > 0.0)) return 1.0;
+  try {
+    // The chi-square upper tail is the regularised upper incomplete gamma Q(dof / 2, chi2 / 2).
+    return boost::math::gamma_q(0.5 * dof, 0.5 * chi2);
+  } catch (const std::exception&) {
+    return 0.0;  // an evaluation error far out in the tail
+  }
 }
 
 bool fillResult(const JointProblem& problem, const State& state, const BuiltProblem& built,

@@ -299,7 +299,7 @@ void jointLine(const AlignmentResult& r, std::string* text, cv::Scalar* colour) 
     *colour = kRed;
   } else {
     *text = "joint estimate: " + jointConsistencyText(*r.joint);
-    *colour = r.joint->chi2_p_value >= kConsistencyLevel ? kGreen : kRed;
+    *colour = r.joint->consistent() ? kGreen : kRed;
   }
 }
 

@@ -48,8 +48,8 @@ std::string jointToYaml(const JointResult& j) {
   out << "  chi2: " << j.chi2 << "\n";
   out << "  dof: " << j.dof << "\n";
   out << "  chi2_p_value: " << j.chi2_p_value << "\n";
-  out << "  consistent: " << boolText(j.chi2_p_value >= kConsistencyLevel)
-      << "  # chi-square test at the " << kConsistencyLevel << " level\n";
+  out << "  consistent: " << boolText(j.consistent()) << "  # chi-square p >= consistency_level\n";
+  out << "  consistency_level: " << j.consistency_level << "\n";
   out << "  covariance_scale: " << j.covariance_scale << "  # chi2/dof when > 1, applied\n";
   out << "  std_dev_deg: " << flow(j.std_dev_deg) << "  # 1-sigma about the camera x, y, z axes\n";
   out << "  iterations: " << j.iterations << "\n";

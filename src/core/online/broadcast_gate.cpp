@@ -40,6 +40,9 @@ GateOutcome judgeEstimate(const AlignmentResult& r, std::size_t window_poses,
   why.precision(3);
   const double sigma = r.quality.std_dev_deg.maxCoeff();
   const bool joint = r.joint.has_value();
+  out.consistent = joint && r.joint->ok && r.joint->chi2_p_value >= settings.consistency_level;
+  out.determined = r.status == SolveStatus::kOk && r.R_cam_imu.allFinite() &&
+                   r.quality.std_dev_deg.allFinite() && sigma <= settings.max_std_dev_deg;
   if (r.status != SolveStatus::kOk) {
     why << r.message;
   } else if (!r.R_cam_imu.allFinite() || !r.quality.std_dev_deg.allFinite()) {
@@ -48,7 +51,7 @@ GateOutcome judgeEstimate(const AlignmentResult& r, std::size_t window_poses,
     why << window_poses << " poses in the window, min_poses is " << settings.min_poses;
   } else if (joint && !r.joint->ok) {
     why << "the joint estimate failed: " << r.joint->message;
-  } else if (joint && !(r.joint->chi2_p_value >= settings.consistency_level)) {
+  } else if (joint && !out.consistent) {
     why << "the data do not fit one mount with the modelled noise: chi2/dof "
         << (r.joint->dof > 0 ? r.joint->chi2 / r.joint->dof : 0.0) << ", p "
         << r.joint->chi2_p_value << " < consistency_level " << settings.consistency_level
@@ -56,7 +59,7 @@ GateOutcome judgeEstimate(const AlignmentResult& r, std::size_t window_poses,
   } else if (!joint && !(r.quality.residual_rms_deg <= settings.max_residual_deg)) {
     why << "residual RMS " << r.quality.residual_rms_deg << " deg > max_residual_deg "
         << settings.max_residual_deg;
-  } else if (!(sigma <= settings.max_std_dev_deg)) {
+  } else if (!out.determined) {
     why << "1-sigma " << sigma << " deg > max_std_dev_deg " << settings.max_std_dev_deg
         << ": more poses, rotated about other axes";
   } else if (broadcast && !fresh_start && sigma > broadcast->maxStdDevDeg() &&
@@ -69,7 +72,12 @@ GateOutcome judgeEstimate(const AlignmentResult& r, std::size_t window_poses,
   } else if (broadcast && rad2deg(rotationAngle(broadcast->R_cam_imu.transpose() * r.R_cam_imu)) <=
                               settings.min_change_deg) {
     out.decision = GateDecision::kKeep;
+    out.refines_broadcast = sigma < broadcast->maxStdDevDeg();
     why << "within min_change_deg " << settings.min_change_deg << " of the broadcast estimate";
+    if (out.refines_broadcast) {
+      why << " (its 1-sigma " << sigma << " deg from " << window_poses
+          << " poses replaces the broadcast one's in the saved file)";
+    }
   } else {
     out.decision = GateDecision::kBroadcast;
   }

@@ -72,6 +72,8 @@ struct OnlineCalibrator::Impl {
   bool fresh_start = false;    ///< the broadcast estimate is no reference (remount, reset)
   bool recalibrating = false;  ///< a remount was found and nothing broadcast since
   int remounts = 0;
+  std::vector<RemountEvent> remount_events;  ///< the newest kRemountHistory
+  static constexpr std::size_t kRemountHistory = 100;
   int inconsistent_poses = 0;  ///< pair modes: consecutive poses off the broadcast estimate
   bool capture_armed = false;
 
@@ -105,6 +107,9 @@ struct OnlineCalibrator::Impl {
   EstimateEvent judged(SolveOutput output) const;
   void applyEstimate(EstimateEvent event);
   void doBroadcast(const AlignmentResult& result, std::size_t poses);
+  /// A more precise estimate within min_change_deg: the tf keeps its rotation, the saved file
+  /// and the broadcast 1-sigma become the new estimate's (on_broadcast saves it).
+  void refineBroadcast(const AlignmentResult& result, std::size_t poses);
 };
 
 OnlineCalibrator::Impl::Impl(const TargetDescription& target,
@@ -188,9 +193,10 @@ void OnlineCalibrator::Impl::restartWindowAt(int first_index, int kept_index, do
   inconsistent_poses = 0;
   recalibrating = fresh_start = true;
   setState(CalibrationState::kRecalibrating, text);
-  if (callbacks.on_remount) {
-    callbacks.on_remount({first_index, kept_index, change_deg, pipeline->windowSize(), text});
-  }
+  const RemountEvent event{first_index, kept_index, change_deg, pipeline->windowSize(), text};
+  if (remount_events.size() >= kRemountHistory) remount_events.erase(remount_events.begin());
+  remount_events.push_back(event);
+  if (callbacks.on_remount) callbacks.on_remount(event);
 }
 
 void OnlineCalibrator::Impl::requestSolve() {
@@ -226,6 +232,8 @@ EstimateEvent OnlineCalibrator::Impl::judged(SolveOutput output) const {
   event.window_poses = output.window.pose_indices.size();
   event.mount_test = std::move(output.mount_test);
   event.gate = judgeEstimate(event.result, event.window_poses, settings, broadcast, fresh_start);
+  // The gate's consistency verdict travels with the result: the YAML and the report print it.
+  if (event.result.joint) event.result.joint->consistency_level = settings.consistency_level;
   if (event.mount_test && event.mount_test->pending &&
       event.gate.decision == GateDecision::kBroadcast) {
     // The newest pose disagrees with the window as a remount would: an estimate over both mounts
@@ -274,6 +282,7 @@ void OnlineCalibrator::Impl::applyEstimate(EstimateEvent event) {
                "estimate not broadcast: " + event.gate.why);
       return;
     case GateDecision::kKeep:
+      if (event.gate.refines_broadcast) refineBroadcast(event.result, event.window_poses);
       setState(CalibrationState::kCalibrated, "the broadcast estimate stays: " + event.gate.why);
       return;
     case GateDecision::kBroadcast:
@@ -294,6 +303,18 @@ void OnlineCalibrator::Impl::doBroadcast(const AlignmentResult& result, std::siz
   fresh_start = recalibrating = false;
   inconsistent_poses = 0;
   setState(CalibrationState::kCalibrated, result.message);
+  if (callbacks.on_broadcast) callbacks.on_broadcast(b);
+}
+
+void OnlineCalibrator::Impl::refineBroadcast(const AlignmentResult& result, std::size_t poses) {
+  if (!broadcast) return;
+  BroadcastEstimate& b = *broadcast;
+  b.std_dev_deg = result.quality.std_dev_deg;
+  b.covariance_rad2.reset();
+  if (result.joint && result.joint->ok) b.covariance_rad2 = result.joint->covariance_rad2;
+  b.poses = static_cast<int>(poses);
+  b.source = "estimated";
+  b.result = result;
   if (callbacks.on_broadcast) callbacks.on_broadcast(b);
 }
 
@@ -369,7 +390,9 @@ CalibrateOutcome OnlineCalibrator::calibrateNow(bool force) {
     return out;
   }
   EstimateEvent event = impl_->judged(std::move(output));
+  out.result = event.result;
   out.gate = event.gate;
+  out.verdict = recordingVerdict(event, impl_->remount_events);
   const bool forcible = force && event.gate.decision != GateDecision::kBroadcast &&
                         event.result.status == SolveStatus::kOk &&
                         event.result.R_cam_imu.allFinite();
@@ -400,6 +423,7 @@ void OnlineCalibrator::reset() {
   impl_->last_pose.reset();
   impl_->inconsistent_poses = 0;
   impl_->remounts = 0;
+  impl_->remount_events.clear();
   impl_->recalibrating = false;
   impl_->capture_armed = false;
   impl_->fresh_start = true;  // starting over: the next good estimate replaces the tf
@@ -430,39 +454,47 @@ const std::optional<EstimateEvent>& OnlineCalibrator::lastEstimate() const {
 const std::optional<BroadcastEstimate>& OnlineCalibrator::broadcast() const {
   return impl_->broadcast;
 }
-const std::optional<StationaryPose>& OnlineCalibrator::lastPose() const { return impl_->last_pose; }
-int OnlineCalibrator::remounts() const { return impl_->remounts; }
 double OnlineCalibrator::newestStamp() const { return impl_->clock.newest(); }
-const CalibrationPipeline& OnlineCalibrator::pipeline() const { return *impl_->pipeline; }
 const OnlineSettings& OnlineCalibrator::settings() const { return impl_->settings; }
 
-std::string OnlineCalibrator::imuGuidance() const {
-  if (!impl_->last_estimate || !impl_->last_estimate->result.joint) return "";
-  const JointResult& joint = *impl_->last_estimate->result.joint;
-  if (!joint.ok) return "";
-  std::string held;
-  for (const EstimatedValue& value : joint.parameters) {
-    if (value.estimated) continue;
-    held += (held.empty() ? "" : ", ") + value.name;
-  }
-  if (held.empty()) return "";
-  const Eigen::Vector3d axis_cam = joint.R_cam_imu * joint.suggested_rotation_axis_imu;
-  char text[160];
-  std::snprintf(text, sizeof(text),
-                "; to calibrate them, rotate about the camera axis (%.2f, %.2f, %.2f)",
-                axis_cam.x(), axis_cam.y(), axis_cam.z());
-  return "IMU parameters held at their priors: " + held + text;
+InputCounts OnlineCalibrator::inputCounts() const {
+  const CalibrationPipeline& p = *impl_->pipeline;
+  InputCounts counts;
+  counts.imu_samples = p.imuSamples();
+  counts.magnetic_samples = p.magneticSamples();
+  counts.frames = p.frames();
+  counts.frames_detected = p.framesDetected();
+  counts.imu_gaps = p.imuGaps();
+  counts.has_intrinsics = p.hasIntrinsics();
+  return counts;
 }
 
-Eigen::Vector3d OnlineCalibrator::rotateAboutCam() const {
-  if (!impl_->last_estimate) return Eigen::Vector3d::UnitX();
-  const AlignmentResult& r = impl_->last_estimate->result;
-  const bool determined = r.status == SolveStatus::kOk &&
-                          r.quality.std_dev_deg.maxCoeff() <= impl_->settings.max_std_dev_deg;
-  if (determined && r.joint && r.joint->ok && !imuGuidance().empty()) {
-    return (r.joint->R_cam_imu * r.joint->suggested_rotation_axis_imu).normalized();
-  }
-  return r.quality.excite_axis_cam;
+CalibrationSnapshot OnlineCalibrator::snapshot() const {
+  const Impl& c = *impl_;
+  const CalibrationPipeline& p = *c.pipeline;
+  CalibrationSnapshot s;
+  s.state = c.state;
+  s.message = c.message;
+  s.newest_stamp_s = c.clock.newest();
+  s.inputs = inputCounts();
+  s.rejections = p.rejections();
+  s.rests_total = p.restsTotal();
+  s.poses_total = p.posesTotal();
+  s.window = p.windowPoses();
+  s.poses = p.poses();
+  s.rejected_poses = p.rejectedPoses();
+  s.rests = p.segments();
+  s.last_pose = c.last_pose;
+  s.latest = c.last_estimate;
+  s.broadcast = c.broadcast;
+  s.latest_is_broadcast = c.last_estimate && c.broadcast &&
+                          rad2deg(rotationAngle(c.broadcast->R_cam_imu.transpose() *
+                                                c.last_estimate->result.R_cam_imu)) <= 1e-9;
+  if (c.last_estimate) s.verdict = recordingVerdict(*c.last_estimate, c.remount_events);
+  s.remount_events = c.remount_events;
+  s.remounts = c.remounts;
+  s.progress = progressOf(c.last_estimate, c.settings.max_std_dev_deg);
+  return s;
 }
 
 }  // namespace camera_imu_alignment

@@ -158,8 +158,7 @@ CalibrationPipeline::Impl::Impl(const TargetDescription& target_, const Pipeline
       symmetries(detector.symmetries()),
       stationary(settings_.stationary),
       disturbance(settings_.disturbance),
-      window(settings_.window_poses),
-      joint_window(settings_.window_poses) {}
+      window(settings_.window_poses) {}
 
 void CalibrationPipeline::Impl::reject(RejectReason reason, InputStream stream,
                                        const std::string& detail) {
@@ -387,13 +386,10 @@ ImuOrientationSource CalibrationPipeline::imuOrientationSource() const {
   return impl_->settings.imu_orientation;
 }
 
-void CalibrationPipeline::keepPosesFrom(int pose_index) {
-  const std::size_t in_window = std::min(impl_->poses.size(), impl_->window.size());
-  std::size_t keep = 0;
-  for (std::size_t i = impl_->poses.size() - in_window; i < impl_->poses.size(); ++i) {
-    if (impl_->poses[i].index >= pose_index) ++keep;
-  }
-  keepNewestPoses(keep);
+void CalibrationPipeline::keepPosesFrom(int pose_index) { impl_->window.keepFrom(pose_index); }
+
+std::vector<StationaryPose> CalibrationPipeline::windowPoses() const {
+  return impl_->window.poses();
 }
 
 void CalibrationPipeline::reset(bool clear_counts) {
@@ -413,14 +409,11 @@ void CalibrationPipeline::reset(bool clear_counts) {
   }
 }
 
-void CalibrationPipeline::keepNewestPoses(std::size_t count) {
-  impl_->window.keepNewest(count);
-  impl_->joint_window.keepNewest(count);
-}
+void CalibrationPipeline::keepNewestPoses(std::size_t count) { impl_->window.keepNewest(count); }
 std::size_t CalibrationPipeline::windowSize() const { return impl_->window.size(); }
 
 const std::vector<StationaryPose>& CalibrationPipeline::poses() const { return impl_->poses; }
-RotationPairs CalibrationPipeline::windowPairs() const { return impl_->window.makePairs(); }
+RotationPairs CalibrationPipeline::windowPairs() const { return impl_->window.pairs(); }
 const std::vector<RejectedPose>& CalibrationPipeline::rejectedPoses() const {
   return impl_->rejected;
 }

@@ -9,7 +9,8 @@
 #include <vector>
 
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
-#include "joint_window.h"
+#include "camera_imu_alignment/pipeline/stationary_window.h"
+#include "rest_statistics.h"
 
 namespace camera_imu_alignment {
 
@@ -70,8 +71,7 @@ struct CalibrationPipeline::Impl {
   std::vector<StationarySegment> segments;
   std::vector<StationaryPose> poses;
   std::vector<RejectedPose> rejected;
-  PoseWindow window;
-  JointWindow joint_window;  ///< the same poses' measurements for the joint estimate
+  StationaryWindow window;  ///< the poses the next solve uses, with their joint measurements
   /// Raw gyro samples since the last pose's rest (through rests that became no pose); empty
   /// optional while there is no pose yet or the gyro chain broke since.
   std::optional<GyroSegment> joint_gyro_pending;
@@ -99,11 +99,11 @@ struct CalibrationPipeline::Impl {
   /// The camera orientation from the frames inside the rest; the reason the rest is no pose, or "".
   std::string assessCamera(const StationarySegment& segment, StationaryPose* pose);
   /// Adds the pose to the history and the window, reports it and solves when enough.
-  void acceptPose(const StationaryPose& pose, JointWindow::Entry joint_entry);
+  void acceptPose(const StationaryPose& pose, StationaryWindow::Entry joint_entry);
   /// The rest's measurements for the joint estimate (before the buffers move on); advances
   /// joint_gyro_pending by the gyro samples since the previous rest.
-  JointWindow::Entry jointMeasurements(const StationarySegment& segment, const StationaryPose& pose,
-                                       const SegmentField& field);
+  StationaryWindow::Entry jointMeasurements(const StationarySegment& segment,
+                                            const StationaryPose& pose, const SegmentField& field);
   void solveAndReport();
   AlignmentResult solve() const;
   WindowSnapshot snapshot() const;

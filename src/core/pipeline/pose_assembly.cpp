@@ -125,7 +125,7 @@ void CalibrationPipeline::Impl::onSegment(const StationarySegment& segment) {
   pose.gyro_bias_rad_s = segment.gyro_bias_rad_s;
   const SegmentField field = assessMagnetometer(segment, &pose);
   integrateGyroSincePrevious(segment, &pose);
-  JointWindow::Entry joint_entry = jointMeasurements(segment, pose, field);
+  StationaryWindow::Entry joint_entry = jointMeasurements(segment, pose, field);
   chooseImuOrientation(segment, &pose);
   const std::string rejection = assessCamera(segment, &pose);
   if (!rejection.empty()) {
@@ -137,11 +137,10 @@ void CalibrationPipeline::Impl::onSegment(const StationarySegment& segment) {
   acceptPose(pose, std::move(joint_entry));
 }
 
-JointWindow::Entry CalibrationPipeline::Impl::jointMeasurements(const StationarySegment& segment,
-                                                                const StationaryPose& pose,
-                                                                const SegmentField& field) {
-  JointWindow::Entry entry;
-  JointPose& jp = entry.pose;
+StationaryWindow::Entry CalibrationPipeline::Impl::jointMeasurements(
+    const StationarySegment& segment, const StationaryPose& pose, const SegmentField& field) {
+  StationaryWindow::Entry entry;
+  JointPose& jp = entry.joint;
   jp.start_s = segment.start_s;
   jp.end_s = segment.end_s;
   const RestStatistics rest = restStatistics(imu_buffer, segment.start_s, segment.end_s);
@@ -311,25 +310,20 @@ std::string CalibrationPipeline::Impl::assessCamera(const StationarySegment& seg
 }
 
 void CalibrationPipeline::Impl::acceptPose(const StationaryPose& pose,
-                                           JointWindow::Entry joint_entry) {
+                                           StationaryWindow::Entry joint_entry) {
   // The camera's covariance from the frames' scatter about their average (per axis, of the mean),
   // with a floor for what the scatter cannot show (intrinsics, the target's flatness).
   const double spread_rad = deg2rad(pose.camera_spread_deg);
   const double variance = spread_rad * spread_rad / (3.0 * std::max(1, pose.num_frames)) +
                           std::pow(deg2rad(kCameraSigmaFloorDeg), 2);
-  joint_entry.pose.R_target_cam = pose.R_target_cam;
-  joint_entry.pose.cov_cam_rad2 = variance * Eigen::Matrix3d::Identity();
-  joint_entry.pose.group = pose.group;
-  joint_window.add(std::move(joint_entry));
+  joint_entry.joint.R_target_cam = pose.R_target_cam;
+  joint_entry.joint.cov_cam_rad2 = variance * Eigen::Matrix3d::Identity();
+  joint_entry.joint.group = pose.group;
+  joint_entry.pose = pose;
+  window.add(std::move(joint_entry));
   joint_gyro_pending = GyroSegment{};  // the next motion starts at this rest
   pushBounded(&poses, pose);
   ++poses_total;
-  PoseOrientation orientation;
-  orientation.stamp_s = 0.5 * (pose.start_s + pose.end_s);
-  orientation.R_target_cam = pose.R_target_cam;
-  orientation.R_world_imu = pose.R_world_imu;
-  orientation.group = pose.group;
-  window.add(orientation);
   if (callbacks.on_pose) callbacks.on_pose(pose);
   if (settings.solve_after_each_pose &&
       static_cast<int>(window.size()) >= settings.min_poses_to_solve) {
@@ -343,12 +337,11 @@ AlignmentResult CalibrationPipeline::Impl::solve() const {
 
 WindowSnapshot CalibrationPipeline::Impl::snapshot() const {
   WindowSnapshot out;
-  out.pairs = window.makePairs();
-  if (usesJointEstimate(settings.imu_orientation)) out.joint = joint_window.problem();
+  out.pairs = window.pairs();
+  if (usesJointEstimate(settings.imu_orientation)) out.joint = window.problem();
   // The paper's sensors: the IMU orientation from gravity and the field alone, the gyro left out.
   if (settings.imu_orientation == ImuOrientationSource::kMagnetometer) out.joint.segments.clear();
-  const std::size_t first = poses.size() - std::min(poses.size(), window.size());
-  for (std::size_t i = first; i < poses.size(); ++i) out.pose_indices.push_back(poses[i].index);
+  for (const StationaryPose& pose : window.poses()) out.pose_indices.push_back(pose.index);
   return out;
 }
 

@@ -6,27 +6,6 @@
 
 namespace camera_imu_alignment {
 
-PoseWindow::PoseWindow(std::size_t max_poses) : max_poses_(std::max<std::size_t>(2, max_poses)) {}
-
-bool PoseWindow::add(const PoseOrientation& pose) {
-  if (!isRotationMatrix(pose.R_target_cam, 1e-6) || !isRotationMatrix(pose.R_world_imu, 1e-6)) {
-    return false;
-  }
-  poses_.push_back(pose);
-  while (poses_.size() > max_poses_) poses_.pop_front();
-  return true;
-}
-
-void PoseWindow::clear() { poses_.clear(); }
-
-void PoseWindow::keepNewest(std::size_t count) {
-  while (poses_.size() > count) poses_.pop_front();
-}
-
-RotationPairs PoseWindow::makePairs() const {
-  return makeAllPairs(std::vector<PoseOrientation>(poses_.begin(), poses_.end()));
-}
-
 RotationPairs makeAllPairs(const std::vector<PoseOrientation>& poses) {
   RotationPairs pairs;
   const int P = static_cast<int>(poses.size());

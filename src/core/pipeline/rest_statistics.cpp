@@ -1,4 +1,5 @@
-#include "joint_window.h"
+// Rest statistics and gyro samples for the joint estimate (rest_statistics.h).
+#include "rest_statistics.h"
 
 #include <cmath>
 
@@ -56,30 +57,6 @@ void appendGyroSamples(const std::deque<ImuSample>& samples, double from_s, doub
     segment->stamps_s.push_back(s.stamp_s);
     segment->gyro_rad_s.push_back(s.gyro_rad_s);
   }
-}
-
-void JointWindow::add(Entry entry) {
-  entries_.push_back(std::move(entry));
-  while (entries_.size() > max_poses_) entries_.pop_front();
-}
-
-void JointWindow::keepNewest(std::size_t count) {
-  while (entries_.size() > count) entries_.pop_front();
-}
-
-JointProblem JointWindow::problem() const {
-  JointProblem problem;
-  for (std::size_t i = 0; i < entries_.size(); ++i) {
-    problem.poses.push_back(entries_[i].pose);
-    const auto& gyro = entries_[i].gyro_from_previous;
-    if (i == 0 || !gyro || gyro->stamps_s.size() < 2) continue;
-    if (entries_[i - 1].pose.group != entries_[i].pose.group) continue;
-    GyroSegment segment = *gyro;
-    segment.from_pose = static_cast<int>(i) - 1;
-    segment.to_pose = static_cast<int>(i);
-    problem.segments.push_back(std::move(segment));
-  }
-  return problem;
 }
 
 }  // namespace camera_imu_alignment

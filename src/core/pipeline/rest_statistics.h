@@ -1,12 +1,9 @@
-// What the joint estimator needs of the poses in the pipeline's window (estimation/joint_types.h):
-// each pose's averaged measurements with their covariances, measured on the rest itself, and the
-// raw gyro samples since the previous pose. Kept beside the PoseWindow and trimmed with it.
-// Private to the pipeline; not installed.
+// What the joint estimator needs of a rest (estimation/joint_types.h): the averaged measurements
+// with their covariances, measured on the rest itself, and the raw gyro samples since the previous
+// pose. Private to the pipeline; not installed.
 #pragma once
 
-#include <cstddef>
 #include <deque>
-#include <optional>
 
 #include "camera_imu_alignment/estimation/joint_types.h"
 #include "camera_imu_alignment/inertial/inertial_samples.h"
@@ -30,28 +27,5 @@ RestStatistics restStatistics(const std::deque<ImuSample>& samples, double start
 /// Appends the raw gyro samples with stamps in [from_s, to_s] to `segment`.
 void appendGyroSamples(const std::deque<ImuSample>& samples, double from_s, double to_s,
                        GyroSegment* segment);
-
-/// The joint estimator's view of the window: one entry per pose, oldest first.
-class JointWindow {
- public:
-  struct Entry {
-    JointPose pose;
-    /// Gyro samples from the previous pose's rest to this one's (same chain), if recorded.
-    std::optional<GyroSegment> gyro_from_previous;
-  };
-
-  explicit JointWindow(std::size_t max_poses) : max_poses_(max_poses) {}
-  void add(Entry entry);
-  void keepNewest(std::size_t count);
-  void clear() { entries_.clear(); }
-  std::size_t size() const { return entries_.size(); }
-  /// The problem of the poses in the window: a gyro segment is kept when its previous pose is in
-  /// the window and of the same group.
-  JointProblem problem() const;
-
- private:
-  std::size_t max_poses_;
-  std::deque<Entry> entries_;
-};
 
 }  // namespace camera_imu_alignment

@@ -1,0 +1,120 @@
+// What the online calibrator knows at one moment, as one ROS-free value (OnlineCalibrator::
+// snapshot()): state, counts, the poses in the window, the latest estimate with its verdicts, the
+// broadcast estimate, remounts, guidance and progress. Every output reads it (the nodelet's
+// ~status, diagnostics and ~stationary_poses; calibrate_bag's summary, verdict, progress line,
+// --export-poses, YAML and report), so that each verdict is decided once, in the core.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "camera_imu_alignment/inertial/stationary_detector.h"
+#include "camera_imu_alignment/online/broadcast_gate.h"
+#include "camera_imu_alignment/online/online_types.h"
+#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/pipeline/input_rejections.h"
+
+namespace camera_imu_alignment {
+
+/// A solve of the window and what the gates made of it.
+struct EstimateEvent {
+  AlignmentResult result;
+  GateOutcome gate;              ///< decision, why, and the consistent / determined verdicts
+  std::size_t window_poses = 0;  ///< poses the estimate used
+  bool forced = false;           ///< broadcast on request although a gate failed
+  std::optional<MountChangeTest> mount_test;
+};
+
+/// A mount change found.
+struct RemountEvent {
+  int first_pose_index = 0;  ///< StationaryPose::index of the first pose of the new mount
+  /// The window restarted from this pose (>= first_pose_index: a later split fitted as well, and
+  /// an old-mount pose would bias the new estimate).
+  int first_pose_kept = 0;
+  double change_deg = 0;       ///< between the two mounts' estimates (0 when unknown: pair modes)
+  std::size_t poses_kept = 0;  ///< poses of the new mount left in the window
+  std::string message;
+};
+
+/// The recording's verdict (calibrate_bag's "verdict:" line; the nodelet's status): would the
+/// estimate be broadcast, and was the mount one mount throughout.
+struct CalibrationVerdict {
+  bool passed = false;  ///< the gates passed (broadcast or kept) and no remount was found
+  std::string text;     ///< "PASSED (...)" or "FAILED: <the gate or the remount>"
+};
+
+/// The verdict of a solved estimate (none when it is not solved and observable: the estimate's own
+/// message says what is missing) given the remounts found since the start or the last reset.
+std::optional<CalibrationVerdict> recordingVerdict(const EstimateEvent& estimate,
+                                                   const std::vector<RemountEvent>& remounts);
+
+/// How far the window is from a broadcast estimate of the required precision.
+struct CalibrationProgress {
+  /// Largest 1-sigma (deg) of the latest estimate; infinite before the first.
+  double std_dev_deg = 0;
+  double max_std_dev_deg = 0;  ///< the setting it must reach
+  /// Poses still needed to reach max_std_dev_deg at the present rate (1-sigma falling as
+  /// 1/sqrt(poses)); 0 when reached; -1 when unknown (no estimate yet).
+  int poses_needed = -1;
+  /// The camera axis to rotate about next (unit vector, camera frame).
+  Eigen::Vector3d rotate_about_cam = Eigen::Vector3d::UnitX();
+  /// Which IMU parameters are still held at their priors and how to excite them ("" when none).
+  std::string imu_guidance;
+};
+
+/// "IMU parameters held at their priors: ...; to calibrate them, rotate about the camera axis
+/// (x, y, z)" for a joint estimate that holds some ("" otherwise).
+std::string imuGuidanceOf(const EstimateEvent& estimate);
+/// The progress of the latest estimate towards max_std_dev_deg.
+CalibrationProgress progressOf(const std::optional<EstimateEvent>& estimate,
+                               double max_std_dev_deg);
+
+/// Input counters since the start (kept over a reset); cheap to read per sample.
+struct InputCounts {
+  std::uint64_t imu_samples = 0, magnetic_samples = 0, frames = 0;
+  std::uint64_t frames_detected = 0;  ///< frames at rest on which detection ran
+  std::uint64_t imu_gaps = 0;         ///< IMU stamp gaps that ended a rest
+  bool has_intrinsics = false;
+};
+/// One line for the logs: "1-sigma 0.120 deg, max_std_dev_deg 0.050 reached" or "1-sigma 0.120
+/// deg > max_std_dev_deg 0.050: about 9 more poses, rotating about the camera axis (0.10, 0.99,
+/// 0.00)".
+std::string progressText(const CalibrationProgress& progress);
+
+struct CalibrationSnapshot {
+  CalibrationState state = CalibrationState::kWaitingForData;
+  std::string message;         ///< what the state means now, for the user
+  double newest_stamp_s = -1;  ///< newest stamp on any input (s), -1 before the first
+
+  // --- inputs
+  InputCounts inputs;
+  RejectionCounts rejections;
+
+  // --- poses
+  std::size_t rests_total = 0, poses_total = 0;  ///< since the start or the last reset
+  std::vector<StationaryPose> window;            ///< the poses the next solve uses, oldest first
+  std::vector<StationaryPose> poses;             ///< the newest kHistoryLimit poses
+  std::vector<RejectedPose> rejected_poses;      ///< rests that became no pose (newest)
+  std::vector<StationarySegment> rests;          ///< the newest kHistoryLimit IMU rests
+  std::optional<StationaryPose> last_pose;
+
+  // --- estimates
+  std::optional<EstimateEvent> latest;  ///< the latest solve, as judged
+  /// The latest estimate is what the static tf says now.
+  bool latest_is_broadcast = false;
+  std::optional<BroadcastEstimate> broadcast;  ///< what the static tf says
+  std::optional<CalibrationVerdict> verdict;   ///< of the latest estimate (recordingVerdict)
+  std::vector<RemountEvent> remount_events;    ///< since the start or the last reset (newest 100)
+  int remounts = 0;
+  CalibrationProgress progress;
+
+  /// The window's poses as the poses CSV holds them (solve_rotation --poses): the stamp in the
+  /// middle of the rest.
+  std::vector<PoseOrientation> windowOrientations() const;
+};
+
+}  // namespace camera_imu_alignment

@@ -1,0 +1,100 @@
+// The calibrator's snapshot: verdict, guidance and progress (calibration_snapshot.h).
+#include "camera_imu_alignment/online/calibration_snapshot.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "camera_imu_alignment/pipeline/stationary_window.h"
+
+namespace camera_imu_alignment {
+
+std::optional<CalibrationVerdict> recordingVerdict(const EstimateEvent& estimate,
+                                                   const std::vector<RemountEvent>& remounts) {
+  if (estimate.result.status != SolveStatus::kOk) return std::nullopt;
+  const bool gates_passed = estimate.gate.decision != GateDecision::kReject;
+  CalibrationVerdict verdict;
+  verdict.passed = gates_passed && remounts.empty();
+  if (!remounts.empty()) {
+    verdict.text = "FAILED: the mount changed during the recording (first before pose " +
+                   std::to_string(remounts.front().first_pose_index) +
+                   "); the estimate is of the last mount, from the poses after the change";
+    if (!gates_passed) verdict.text += "; and " + estimate.gate.why;
+  } else if (!gates_passed) {
+    verdict.text = "FAILED: " + estimate.gate.why;
+  } else {
+    verdict.text = "PASSED (the nodelet would broadcast it)";
+  }
+  return verdict;
+}
+
+std::string imuGuidanceOf(const EstimateEvent& estimate) {
+  if (!estimate.result.joint || !estimate.result.joint->ok) return "";
+  const JointResult& joint = *estimate.result.joint;
+  std::string held;
+  for (const EstimatedValue& value : joint.parameters) {
+    if (value.estimated) continue;
+    held += (held.empty() ? "" : ", ") + value.name;
+  }
+  if (held.empty()) return "";
+  const Eigen::Vector3d axis_cam = joint.R_cam_imu * joint.suggested_rotation_axis_imu;
+  char text[160];
+  std::snprintf(text, sizeof(text),
+                "; to calibrate them, rotate about the camera axis (%.2f, %.2f, %.2f)",
+                axis_cam.x(), axis_cam.y(), axis_cam.z());
+  return "IMU parameters held at their priors: " + held + text;
+}
+
+CalibrationProgress progressOf(const std::optional<EstimateEvent>& estimate,
+                               double max_std_dev_deg) {
+  CalibrationProgress progress;
+  progress.max_std_dev_deg = max_std_dev_deg;
+  progress.std_dev_deg = std::numeric_limits<double>::infinity();
+  if (!estimate) return progress;
+  const AlignmentResult& r = estimate->result;
+  progress.imu_guidance = imuGuidanceOf(*estimate);
+  // While R_cam_imu is not determined, the axis the pairs excite least; once it is, the axis that
+  // would calibrate the IMU parameters still held.
+  progress.rotate_about_cam = r.quality.excite_axis_cam;
+  if (estimate->gate.determined && r.joint && r.joint->ok && !progress.imu_guidance.empty()) {
+    progress.rotate_about_cam =
+        (r.joint->R_cam_imu * r.joint->suggested_rotation_axis_imu).normalized();
+  }
+  if (r.status != SolveStatus::kOk || !r.quality.std_dev_deg.allFinite()) return progress;
+  progress.std_dev_deg = r.quality.std_dev_deg.maxCoeff();
+  if (progress.std_dev_deg <= max_std_dev_deg) {
+    progress.poses_needed = 0;
+  } else if (estimate->window_poses > 0) {
+    // 1-sigma ~ 1/sqrt(poses): n (sigma / max)^2 poses reach max_std_dev_deg.
+    const double ratio = progress.std_dev_deg / max_std_dev_deg;
+    const double needed = static_cast<double>(estimate->window_poses) * ratio * ratio;
+    progress.poses_needed = static_cast<int>(
+        std::ceil(std::min(needed, 1e6) - static_cast<double>(estimate->window_poses)));
+  }
+  return progress;
+}
+
+std::string progressText(const CalibrationProgress& progress) {
+  if (!std::isfinite(progress.std_dev_deg)) return "no estimate yet";
+  char text[240];
+  if (progress.poses_needed == 0) {
+    std::snprintf(text, sizeof(text), "1-sigma %.3f deg, max_std_dev_deg %.3f reached",
+                  progress.std_dev_deg, progress.max_std_dev_deg);
+  } else {
+    const Eigen::Vector3d& axis = progress.rotate_about_cam;
+    std::snprintf(text, sizeof(text),
+                  "1-sigma %.3f deg > max_std_dev_deg %.3f: about %d more poses, rotating about "
+                  "the camera axis (%.2f, %.2f, %.2f)",
+                  progress.std_dev_deg, progress.max_std_dev_deg, progress.poses_needed, axis.x(),
+                  axis.y(), axis.z());
+  }
+  return text;
+}
+
+std::vector<PoseOrientation> CalibrationSnapshot::windowOrientations() const {
+  std::vector<PoseOrientation> out;
+  for (const StationaryPose& pose : window) out.push_back(orientationOf(pose));
+  return out;
+}
+
+}  // namespace camera_imu_alignment
