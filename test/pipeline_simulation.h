@@ -1,5 +1,7 @@
-// Test harness: one simulated run (camera_imu_alignment_simulation) fed to a CalibrationPipeline
-// in stamp order, the way calibrate_bag and the nodelet feed it, without a bag.
+// Test harness: one simulated run (camera_imu_alignment_simulation) fed in stamp order, the way
+// calibrate_bag and the nodelet feed it, without a bag: to a CalibrationPipeline (pose assembly;
+// the estimate is the solve of its final window, solveFinalWindow) or to an OnlineCalibrator
+// solving on the caller's thread (the product's path: an estimate after every pose).
 #pragma once
 
 #include <algorithm>
@@ -8,6 +10,7 @@
 #include <random>
 #include <vector>
 
+#include "camera_imu_alignment/online/online_calibrator.h"
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
 #include "camera_imu_alignment/simulation/renderer.h"
 #include "camera_imu_alignment/simulation/simulation_run.h"
@@ -29,13 +32,28 @@ struct Injected {
   std::uint64_t nan_mag = 0, gauss_mag = 0, empty_frames = 0;
 };
 
+/// The estimate from a pipeline's window as it is now (what the online calibrator would solve).
+inline AlignmentResult solveFinalWindow(const CalibrationPipeline& pipeline) {
+  return solveWindow(pipeline.snapshot(), pipeline.settings());
+}
+
+/// A simulated run fed to a CalibrationPipeline (runPipeline, feedPipeline).
 struct PipelineRun {
   std::unique_ptr<simulation::SimulationRun> run;
   std::unique_ptr<CalibrationPipeline> pipeline;
-  std::vector<AlignmentResult> results;     ///< every on_result, in order
-  std::vector<std::string> reject_details;  ///< on_reject details, first 200
   Injected injected;
   Eigen::Matrix3d R_cam_imu_true() const { return run->trajectory.R_cam_imu_final(); }
+};
+
+/// A simulated run fed to an OnlineCalibrator solving on the caller's thread (runCalibrator).
+struct CalibratorRun {
+  std::unique_ptr<simulation::SimulationRun> run;
+  std::unique_ptr<OnlineCalibrator> calibrator;
+  /// Every on_estimate, in order (shared: the calibrator's callback holds it too).
+  std::shared_ptr<std::vector<EstimateEvent>> estimates;
+  Injected injected;
+  Eigen::Matrix3d R_cam_imu_true() const { return run->trajectory.R_cam_imu_final(); }
+  const CalibrationPipeline& pipeline() const { return calibrator->pipeline(); }
 };
 
 inline CameraIntrinsics simulatedIntrinsics(const simulation::SimulationConfig& c) {
@@ -52,31 +70,14 @@ inline bool every(std::size_t i, int n) {
   return n > 0 && i % n == static_cast<std::size_t>(n - 1);
 }
 
-/// Feeds a simulated run (possibly edited by the test) to a new pipeline: IMU, magnetometer and
-/// rendered frames merged in stamp order, with `injection` bad samples mixed in.
-inline PipelineRun feedPipeline(std::unique_ptr<simulation::SimulationRun> simulated,
-                                const PipelineSettings& settings, const Injection& injection = {}) {
+/// Feeds a simulated run (possibly edited by the test) to `sink`: IMU, magnetometer and rendered
+/// frames merged in stamp order, with `injection` bad samples mixed in. The caller calls finish().
+inline Injected feedRenderedRun(const simulation::SimulationRun& run, SampleSink* sink,
+                                const Injection& injection = {}) {
   namespace sim = simulation;
-  PipelineRun out;
-  out.run = std::move(simulated);
-  const sim::SimulationRun& run = *out.run;
   const sim::SimulationConfig& c = run.config;
-  const TargetDescription target = parseTargetYaml(sim::targetYaml(c.target), "simulated target");
-  PipelineCallbacks callbacks;
-  std::vector<AlignmentResult>* results = &out.results;
-  callbacks.on_result = [results](const AlignmentResult& r) { results->push_back(r); };
-  std::vector<std::string>* details = &out.reject_details;
-  callbacks.on_reject = [details](RejectReason reason, InputStream stream,
-                                  const std::string& detail) {
-    if (details->size() < 200) {
-      details->push_back(std::string(toString(stream)) + ": " + toString(reason) + ": " + detail);
-    }
-  };
-  out.pipeline = std::make_unique<CalibrationPipeline>(target, settings, callbacks);
-  CalibrationPipeline& pipeline = *out.pipeline;
-  pipeline.setCameraIntrinsics(simulatedIntrinsics(c));
-  Injected& injected = out.injected;
-
+  sink->setCameraIntrinsics(simulatedIntrinsics(c));
+  Injected injected;
   const sim::ImageRenderer renderer(sim::CameraModel::fromConfig(c),
                                     sim::makeTargetTexture(c.target, sim::textureTexelFor(c)),
                                     c.supersample, c.blur_sigma_px);
@@ -92,17 +93,17 @@ inline PipelineRun feedPipeline(std::unique_ptr<simulation::SimulationRun> simul
       const std::size_t i = next_imu++;
       const auto& s = run.imu[i];
       if (every(i, injection.nan_imu_every)) {
-        pipeline.addImu({s.t, Eigen::Vector3d::Constant(nan), s.accel});
+        sink->addImu({s.t, Eigen::Vector3d::Constant(nan), s.accel});
         ++injected.nan_imu;
         continue;
       }
-      pipeline.addImu({s.t, s.gyro, s.accel});
+      sink->addImu({s.t, s.gyro, s.accel});
       if (every(i, injection.duplicate_imu_every)) {
-        pipeline.addImu({s.t, s.gyro, s.accel});
+        sink->addImu({s.t, s.gyro, s.accel});
         ++injected.duplicate_imu;
       }
       if (every(i, injection.backwards_imu_every)) {
-        pipeline.addImu({s.t - 0.5, s.gyro, s.accel});
+        sink->addImu({s.t - 0.5, s.gyro, s.accel});
         ++injected.backwards_imu;
       }
     }
@@ -110,13 +111,13 @@ inline PipelineRun feedPipeline(std::unique_ptr<simulation::SimulationRun> simul
       const std::size_t i = next_mag++;
       const auto& s = run.mag[i];
       if (every(i, injection.nan_mag_every)) {
-        pipeline.addMagnetic({s.t, Eigen::Vector3d(nan, 0.0, 0.0)});
+        sink->addMagnetic({s.t, Eigen::Vector3d(nan, 0.0, 0.0)});
         ++injected.nan_mag;
       } else if (every(i, injection.gauss_mag_every)) {
-        pipeline.addMagnetic({s.t, s.field * 1e4});  // gauss sent as tesla
+        sink->addMagnetic({s.t, s.field * 1e4});  // gauss sent as tesla
         ++injected.gauss_mag;
       } else {
-        pipeline.addMagnetic({s.t, s.field});
+        sink->addMagnetic({s.t, s.field});
       }
     }
   };
@@ -127,7 +128,7 @@ inline PipelineRun feedPipeline(std::unique_ptr<simulation::SimulationRun> simul
     const double stamp = t + c.camera_time_offset_s;
     feedInertialUpTo(stamp);
     if (every(j, injection.empty_frame_every)) {
-      pipeline.addFrame({stamp, cv::Mat()});
+      sink->addFrame({stamp, cv::Mat()});
       ++injected.empty_frames;
       continue;
     }
@@ -146,10 +147,24 @@ inline PipelineRun feedPipeline(std::unique_ptr<simulation::SimulationRun> simul
       const int covered = static_cast<int>(injection.cover_fraction * mono8.cols);
       mono8(cv::Rect(mono8.cols - covered, 0, covered, mono8.rows)).setTo(cv::Scalar(128));
     }
-    pipeline.addFrame({stamp, mono8});
+    sink->addFrame({stamp, mono8});
   }
   feedInertialUpTo(std::numeric_limits<double>::infinity());
-  pipeline.finish();
+  return injected;
+}
+
+inline TargetDescription simulatedTarget(const simulation::SimulationConfig& c) {
+  return parseTargetYaml(simulation::targetYaml(c.target), "simulated target");
+}
+
+/// Feeds a simulated run to a new pipeline (feedRenderedRun), finished.
+inline PipelineRun feedPipeline(std::unique_ptr<simulation::SimulationRun> simulated,
+                                const PipelineSettings& settings, const Injection& injection = {}) {
+  PipelineRun out;
+  out.run = std::move(simulated);
+  out.pipeline = std::make_unique<CalibrationPipeline>(simulatedTarget(out.run->config), settings);
+  out.injected = feedRenderedRun(*out.run, out.pipeline.get(), injection);
+  out.pipeline->finish();
   return out;
 }
 
@@ -160,9 +175,27 @@ inline PipelineRun runPipeline(const simulation::SimulationConfig& config,
   return feedPipeline(std::make_unique<simulation::SimulationRun>(config), settings, injection);
 }
 
-/// A run fed without images: camera orientations given (the truth with `camera_noise_deg` of noise
-/// per axis per frame, at 15 Hz), as through the nodelet's camera_pose topic; optionally the IMU's
-/// own orientation (the truth with 2.5x that noise) in every sample.
+/// Simulates `config` and feeds it to a new OnlineCalibrator (default online settings, solving on
+/// the caller's thread), finished.
+inline CalibratorRun runCalibrator(const simulation::SimulationConfig& config,
+                                   const PipelineSettings& settings = {},
+                                   const Injection& injection = {}) {
+  CalibratorRun out;
+  out.run = std::make_unique<simulation::SimulationRun>(config);
+  out.estimates = std::make_shared<std::vector<EstimateEvent>>();
+  OnlineCallbacks callbacks;
+  callbacks.on_estimate = [estimates = out.estimates](const EstimateEvent& e) {
+    estimates->push_back(e);
+  };
+  OnlineSettings online;
+  online.threaded = false;
+  out.calibrator =
+      std::make_unique<OnlineCalibrator>(simulatedTarget(config), settings, online, callbacks);
+  out.injected = feedRenderedRun(*out.run, out.calibrator.get(), injection);
+  out.calibrator->finish();
+  return out;
+}
+
 /// The joint estimator's priors for a simulated unit: its grade's spread of the systematic errors
 /// (the consumer defaults for the ideal grade, whose errors are zero).
 inline JointSettings jointSettingsFor(const simulation::SimulationConfig& c) {

@@ -46,7 +46,7 @@ GradeRun runGrade(const std::string& scenario, std::uint64_t seed) {
   out.seed = seed;
   out.poses = static_cast<int>(r.pipeline->poses().size());
   out.rests = static_cast<int>(r.run->trajectory.poses().size());
-  const AlignmentResult result = r.pipeline->solve();
+  const AlignmentResult result = test::solveFinalWindow(*r.pipeline);
   if (result.status != SolveStatus::kOk || !result.joint || !result.joint->ok) {
     ADD_FAILURE() << scenario << " seed " << seed << ": " << result.message;
     return out;

@@ -79,7 +79,7 @@ Outcome monteCarlo(const std::string& scenario, int seeds, const Variant& varian
     }
     const auto pipeline = test::feedWithoutImages(run, settings, 0.03, false, 100 + c.seed);
     ++out.runs;
-    const AlignmentResult r = pipeline->solve();
+    const AlignmentResult r = test::solveFinalWindow(*pipeline);
     if (!r.joint || !r.joint->ok) {
       ADD_FAILURE() << scenario << " seed " << c.seed << ": "
                     << (r.joint ? r.joint->message : r.message);
@@ -99,7 +99,8 @@ Outcome monteCarlo(const std::string& scenario, int seeds, const Variant& varian
     PipelineSettings compared = settings;
     compared.imu_orientation = variant.compare_with;
     const auto other = test::feedWithoutImages(run, compared, 0.03, false, 100 + c.seed);
-    const double compared_deg = rad2deg(geodesicDistance(other->solve().R_cam_imu, R_true));
+    const double compared_deg =
+        rad2deg(geodesicDistance(test::solveFinalWindow(*other).R_cam_imu, R_true));
     out.sum_sq_compared_deg += compared_deg * compared_deg;
     const double pair_deg = rad2deg(geodesicDistance(
         solveAlignment(other->snapshot().pairs, compared.solver).R_cam_imu, R_true));
@@ -254,7 +255,7 @@ TEST(JointPipeline, DisturbedFieldsAreLeftOutOnceTheIronIsCalibrated) {
     settings.joint = jointSettingsFor(c);
     settings.imu_orientation = ImuOrientationSource::kMagnetometer;
     const auto pipeline = test::feedWithoutImages(run, settings, 0.03, false, 100 + c.seed);
-    const AlignmentResult r = pipeline->solve();
+    const AlignmentResult r = test::solveFinalWindow(*pipeline);
     ASSERT_TRUE(r.joint && r.joint->ok) << seed << ": " << r.message;
     const ImuIntrinsics& in = r.joint->intrinsics;
     ASSERT_TRUE(in.magnetometer_used && in.hard_iron_estimated) << seed << ": " << r.message;

@@ -1,6 +1,6 @@
 // The offline and online calibration pipeline: time-stamped IMU, magnetometer and camera
-// observations in, stationary poses, relative-rotation pairs and R_cam_imu out. calibrate_bag and
-// the nodelet both drive this class; it holds no ROS type.
+// observations in, stationary poses and their window out (solveWindow gives R_cam_imu). The
+// online calibrator drives this class (for calibrate_bag and the nodelet); it holds no ROS type.
 //
 // Data path:
 //   IMU samples -> validation -> StationaryDetector -> segments (gyro bias, mean accel)
@@ -8,7 +8,8 @@
 //   camera frames -> queued until the IMU shows whether the frame time is at rest; detection + PnP
 //     only on frames at rest (never while moving), at most max_frames_per_pose per pose
 //   segment end -> StationaryPose (camera: robust average of the frame orientations; IMU: see
-//     below) -> StationaryWindow -> solveAlignment -> callbacks.
+//     below) -> StationaryWindow -> on_pose. The pipeline does not solve: its owner (OnlineCalibrator)
+//     takes a snapshot() of the window and solves it with solveWindow, e.g. on a worker thread.
 //
 // R_cam_imu (PipelineSettings::imu_orientation):
 //   kJoint (default): one maximum-likelihood estimate over the window's poses from every sensor
@@ -92,9 +93,6 @@ struct PipelineSettings {
   double max_gyro_span_s = 120.0;      ///< longer motion between poses breaks the gyro chain
   double frame_queue_s = 3.0;          ///< frames older than the IMU by more are dropped (no IMU)
   double accel_weight = 0.9;           ///< attitudeFromAccelMag
-  /// Solve after every new pose and report through on_result (calibrate_bag's own use). The
-  /// online calibrator turns it off and solves snapshots of the window itself (snapshot()).
-  bool solve_after_each_pose = true;
   /// Returns an empty string when usable, else the first unusable setting, named by its key in
   /// config/default.yaml.
   std::string validate() const;
@@ -147,14 +145,13 @@ struct WindowSnapshot {
   std::vector<int> pose_indices;  ///< StationaryPose::index of each window pose, oldest first
 };
 
-/// The solve of CalibrationPipeline::solve(): the pair estimators, then (imu_orientation: joint or
+/// The solve of a window: the pair estimators, then (imu_orientation: joint or
 /// magnetometer) the joint estimate started from the pair estimate. Pure: no pipeline state.
 AlignmentResult solveWindow(const WindowSnapshot& window, const PipelineSettings& settings);
 
 struct PipelineCallbacks {
   std::function<void(const StationaryPose&)> on_pose;
   std::function<void(const RejectedPose&)> on_pose_rejected;
-  std::function<void(const AlignmentResult&)> on_result;
   /// Every rejected input: reason, the stream it came from, and a detail without the stream's
   /// name ("stamp 12.5 s is earlier than ..."); the caller names the topic and throttles.
   std::function<void(RejectReason, InputStream, const std::string&)> on_reject;
@@ -190,9 +187,6 @@ class CalibrationPipeline : public SampleSink {
   ImuOrientationSource imuOrientationSource() const override;
   /// End of data: closes the rest in progress and processes the queued frames.
   void finish();
-  /// Solves on the current window (also done automatically after every new pose unless
-  /// solve_after_each_pose is false).
-  AlignmentResult solve() const;
   /// A copy of the window for solveWindow.
   WindowSnapshot snapshot() const;
   /// Forgets all data (poses, window, buffers; counts kept unless clear_counts); the camera
@@ -209,7 +203,7 @@ class CalibrationPipeline : public SampleSink {
   std::vector<StationaryPose> windowPoses() const;
 
   const std::vector<StationaryPose>& poses() const;  ///< the newest kHistoryLimit poses
-  RotationPairs windowPairs() const;  ///< the pairs solve() uses (poses in the window)
+  RotationPairs windowPairs() const;                 ///< the pairs of the window (as in snapshot())
   const std::vector<RejectedPose>& rejectedPoses() const;
   const std::vector<StationarySegment>& segments() const;  ///< the newest kHistoryLimit rests
   std::size_t posesTotal() const;  ///< poses since the start or the last reset
@@ -218,7 +212,6 @@ class CalibrationPipeline : public SampleSink {
   std::size_t restsTotal() const;  ///< IMU rests (segments) since the start or the last reset
   PipelineBufferSizes bufferSizes() const;
   const RejectionCounts& rejections() const;
-  std::optional<AlignmentResult> lastResult() const;
   /// Counters for progress and diagnostics.
   std::uint64_t imuSamples() const;
   std::uint64_t magneticSamples() const;

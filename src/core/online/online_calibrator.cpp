@@ -118,7 +118,6 @@ OnlineCalibrator::Impl::Impl(const TargetDescription& target,
     : pipeline_settings(pipeline_settings_in), settings(online), callbacks(std::move(cb)) {
   const std::string error = settings.validate();
   if (!error.empty()) throw std::invalid_argument(error);
-  pipeline_settings.solve_after_each_pose = false;  // the calibrator solves snapshots itself
   PipelineCallbacks pc;
   pc.on_pose = [this](const StationaryPose& p) { onPose(p); };
   pc.on_pose_rejected = [this](const RejectedPose& r) { onPoseRejected(r); };

@@ -378,8 +378,6 @@ void CalibrationPipeline::finish() {
   if (auto segment = impl_->stationary.flush()) impl_->onSegment(*segment);
 }
 
-AlignmentResult CalibrationPipeline::solve() const { return impl_->solve(); }
-
 WindowSnapshot CalibrationPipeline::snapshot() const { return impl_->snapshot(); }
 
 ImuOrientationSource CalibrationPipeline::imuOrientationSource() const {
@@ -437,9 +435,6 @@ PipelineBufferSizes CalibrationPipeline::bufferSizes() const {
   sizes.rejected_rests = s.rejected.size();
   sizes.window = s.window.size();
   return sizes;
-}
-std::optional<AlignmentResult> CalibrationPipeline::lastResult() const {
-  return impl_->last_result;
 }
 std::uint64_t CalibrationPipeline::imuSamples() const { return impl_->num_imu; }
 std::uint64_t CalibrationPipeline::magneticSamples() const { return impl_->num_mag; }

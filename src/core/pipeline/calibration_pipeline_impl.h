@@ -76,7 +76,6 @@ struct CalibrationPipeline::Impl {
   /// optional while there is no pose yet or the gyro chain broke since.
   std::optional<GyroSegment> joint_gyro_pending;
   double last_gyro_noise_density = 0.0;  ///< of the previous rest (rad/s/sqrt(Hz))
-  std::optional<AlignmentResult> last_result;
 
   std::size_t poses_total = 0, rests_total = 0;
   std::uint64_t imu_gaps = 0;  ///< IMU stamp gaps longer than settings.stationary.max_gap_s
@@ -98,14 +97,12 @@ struct CalibrationPipeline::Impl {
   void chooseImuOrientation(const StationarySegment& segment, StationaryPose* pose);
   /// The camera orientation from the frames inside the rest; the reason the rest is no pose, or "".
   std::string assessCamera(const StationarySegment& segment, StationaryPose* pose);
-  /// Adds the pose to the history and the window, reports it and solves when enough.
+  /// Adds the pose to the history and the window and reports it (on_pose).
   void acceptPose(const StationaryPose& pose, StationaryWindow::Entry joint_entry);
   /// The rest's measurements for the joint estimate (before the buffers move on); advances
   /// joint_gyro_pending by the gyro samples since the previous rest.
-  StationaryWindow::Entry jointMeasurements(const StationarySegment& segment,
-                                            const StationaryPose& pose, const SegmentField& field);
-  void solveAndReport();
-  AlignmentResult solve() const;
+  StationaryWindow::Entry jointMeasurements(const StationarySegment& segment, const StationaryPose& pose,
+                                       const SegmentField& field);
   WindowSnapshot snapshot() const;
 };
 

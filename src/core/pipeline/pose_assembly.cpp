@@ -325,14 +325,6 @@ void CalibrationPipeline::Impl::acceptPose(const StationaryPose& pose,
   pushBounded(&poses, pose);
   ++poses_total;
   if (callbacks.on_pose) callbacks.on_pose(pose);
-  if (settings.solve_after_each_pose &&
-      static_cast<int>(window.size()) >= settings.min_poses_to_solve) {
-    solveAndReport();
-  }
-}
-
-AlignmentResult CalibrationPipeline::Impl::solve() const {
-  return solveWindow(snapshot(), settings);
 }
 
 WindowSnapshot CalibrationPipeline::Impl::snapshot() const {
@@ -378,13 +370,6 @@ AlignmentResult solveWindow(const WindowSnapshot& window, const PipelineSettings
   }
   result.joint = joint;
   return result;
-}
-
-void CalibrationPipeline::Impl::solveAndReport() {
-  AlignmentResult result = solve();
-  if (result.status == SolveStatus::kBadInput) return;
-  last_result = result;
-  if (callbacks.on_result) callbacks.on_result(result);
 }
 
 }  // namespace camera_imu_alignment
