@@ -9,9 +9,9 @@
 //   * the value as text (the defaults check compares config/default.yaml with the struct's
 //     defaults through it).
 // The pipeline's table (pipeline_config.cpp), the calibrator's (online_config.cpp), the ROS
-// wrapper's (wrapper_settings.cpp) and simulate_bag's options (src/tools/simulate_bag_options.cpp) are written with
-// it. Every bad value is reported in one form, badValueMessage: "<source>: <key> = <value given>:
-// must be <allowed>"; checks across keys are in settings_checks.h.
+// wrapper's (wrapper_settings.cpp) and simulate_bag's options (src/tools/simulate_bag_options.cpp)
+// are written with it. Every bad value is reported in one form, badValueMessage: "<source>: <key>
+// = <value given>: must be <allowed>"; checks across keys are in settings_checks.h.
 #pragma once
 
 #include <yaml-cpp/yaml.h>
