@@ -120,7 +120,7 @@ TEST(JointEstimator, SmallTiltsHoldTheAccelerometerAndStillCoverTheError) {
   // so the scaled 1-sigma, beyond the default refusal at 10 deg.)
   JointSettings pinned;
   pinned.pin_unexcited_parameters = true;
-  pinned.max_std_dev_deg = 90.0;
+  pinned.undetermined_std_dev_deg = 90.0;
   const JointResult r = solveSimulation(simulateJointProblem(options, 40), pinned);
   ASSERT_TRUE(r.ok) << r.message;
   EXPECT_EQ(r.intrinsics.accel_bias_m_s2, Eigen::Vector3d::Zero());

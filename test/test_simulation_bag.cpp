@@ -10,6 +10,7 @@
 #include <iterator>
 #include <map>
 #include <string>
+#include <utility>
 
 #include "camera_imu_alignment/io/result_yaml.h"
 
@@ -57,6 +58,26 @@ TEST(SimulateBag, HelpListsEveryScenario) {
     EXPECT_NE(r.out.find(grade), std::string::npos) << grade;
   }
   EXPECT_NE(r.out.find("--imu-grade"), std::string::npos);
+}
+
+TEST(SimulateBag, OptionsAreCheckedAgainstTheirDeclaredRanges) {
+  // The option table gives the usage line, the check and the message: one declaration.
+  const RunResult help = run(kSim + " --help");
+  EXPECT_NE(help.out.find("--gravity-m-s2 (a number within [9.5, 10.1], m/s^2)"), std::string::npos)
+      << help.out;
+  EXPECT_NE(help.out.find("--mag-disturbance-ut (a number within [0, 1000], uT)"),
+            std::string::npos);
+  const std::pair<std::string, std::string> cases[] = {
+      {" --num-poses 2.5", "--num-poses = 2.5: must be an integer within [2, 1000]"},
+      {" --gravity-m-s2 12", "--gravity-m-s2 = 12: must be a number within [9.5, 10.1]"},
+      {" --motion wobble", "--motion = wobble: must be 'full', 'single_axis' or 'small_angle'"},
+      {" --compression zip", "--compression = zip: must be 'none', 'lz4' or 'bz2'"},
+      {" --earth-field-ut 1,x,3", "--earth-field-ut = 1,x,3: must be 3 numbers x,y,z"}};
+  for (const auto& [options, expected] : cases) {
+    const RunResult r = run(kSim + " --out " + temp("x.bag") + options);
+    EXPECT_EQ(r.exit_code, 2) << options;
+    EXPECT_NE(r.err.find(expected), std::string::npos) << options << " -> " << r.err;
+  }
 }
 
 TEST(SimulateBag, BadUsageExitsTwoNamingTheOption) {

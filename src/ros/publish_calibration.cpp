@@ -12,6 +12,7 @@
 
 #include <exception>
 
+#include "camera_imu_alignment/config/settings_error.h"
 #include "camera_imu_alignment/io/default_frames.h"
 #include "camera_imu_alignment/io/input_error.h"
 #include "camera_imu_alignment/io/result_yaml.h"
@@ -33,7 +34,7 @@ int main(int argc, char** argv) {
   private_nh.param("publish_inverse", publish_inverse, false);
   cia::StoredCalibration stored;
   try {
-    if (file.empty()) throw cia::InputError("~file is required (a result YAML)");
+    if (file.empty()) throw cia::SettingsError("", "file", "~file is required (a result YAML)");
     stored = cia::readResultYaml(cia::expandHome(file));
   } catch (const std::exception& e) {
     ROS_FATAL("%s: cannot start: %s", name.c_str(), e.what());

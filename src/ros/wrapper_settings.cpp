@@ -11,6 +11,7 @@
 
 #include "camera_imu_alignment/config/online_config.h"
 #include "camera_imu_alignment/config/pipeline_config.h"
+#include "camera_imu_alignment/config/settings_checks.h"
 #include "camera_imu_alignment/io/input_error.h"
 
 namespace camera_imu_alignment {
@@ -18,47 +19,36 @@ namespace {
 
 using Key = SettingKey<WrapperSettings>;
 
-template <typename T>
-Key field(const std::string& name, T WrapperSettings::*member, const std::string& allowed) {
-  return fieldKey<T, WrapperSettings>(
-      name, [member](WrapperSettings* s) { return &(s->*member); }, allowed);
-}
-
-// The ranges check() applies, as told in messages.
-const char* const kPath = "a file path (text)";
-const char* const kFrame = "a tf frame name (text), or empty";
-const char* const kBool = "true or false";
-const char* const kPositive = "a finite number > 0";
+/// The member `path` of a WrapperSettings (const or not).
+#define CIA_MEMBER(path) \
+  [](auto& s) -> auto& { return s.path; }
 
 const std::vector<Key>& keys() {
+  const char* const frame = "a tf frame name (text), or empty";
   static const std::vector<Key> table = {
-      field("target_file", &WrapperSettings::target_file, kPath),
-      field("camera_frame", &WrapperSettings::camera_frame, kFrame),
-      field("imu_frame", &WrapperSettings::imu_frame, kFrame),
-      field("publish_inverse", &WrapperSettings::publish_inverse, kBool),
-      field("output_file", &WrapperSettings::output_file, "a file path (text), or empty"),
-      field("load_on_start", &WrapperSettings::load_on_start, kBool),
-      field("status_period_s", &WrapperSettings::status_period_s, kPositive),
-      {"image_transport",
-       [](const YAML::Node& node, WrapperSettings* s) {
-         const std::string transport = node.as<std::string>();
-         if (transport != "raw" && transport != "compressed") {
-           throw YAML::Exception(node.Mark(), "unknown transport");
-         }
-         s->image_transport = transport;
-       },
-       "'raw' or 'compressed'"},
+      textKey<WrapperSettings>("target_file", CIA_MEMBER(target_file), "a file path (text)",
+                               "Kalibr target YAML; required"),
+      textKey<WrapperSettings>("camera_frame", CIA_MEMBER(camera_frame), frame,
+                               "tf frame of the camera; empty: the image header's frame_id"),
+      textKey<WrapperSettings>("imu_frame", CIA_MEMBER(imu_frame), frame,
+                               "tf frame of the IMU; empty: the Imu header's frame_id"),
+      boolKey<WrapperSettings>("publish_inverse", CIA_MEMBER(publish_inverse),
+                               "false: camera -> imu (parent camera); true: imu -> camera"),
+      textKey<WrapperSettings>("output_file", CIA_MEMBER(output_file),
+                               "a file path (text), or empty",
+                               "each accepted calibration is written here; empty: not saved"),
+      boolKey<WrapperSettings>("load_on_start", CIA_MEMBER(load_on_start),
+                               "broadcast output_file's calibration at start if it exists"),
+      numberKey<double, WrapperSettings>("status_period_s", CIA_MEMBER(status_period_s), above(0.0),
+                                         "s",
+                                         "~status and /diagnostics are also published this often"),
+      wordKey<WrapperSettings>("image_transport", CIA_MEMBER(image_transport),
+                               {"raw", "compressed"}, "image_transport's parameter"),
   };
   return table;
 }
 
-/// "<key> = <value>: must be <allowed>" for check(), with the table's words.
-template <typename T>
-std::string bad(const std::string& name, const T& value) {
-  std::ostringstream text;
-  text << value;
-  return name + " = " + text.str() + ": must be " + findKey(keys(), name)->allowed;
-}
+#undef CIA_MEMBER
 
 /// XmlRpc parameter value -> YAML node (scalars and lists; maps are not settings).
 YAML::Node toYaml(XmlRpc::XmlRpcValue& value, const std::string& name) {
@@ -77,16 +67,17 @@ YAML::Node toYaml(XmlRpc::XmlRpcValue& value, const std::string& name) {
       return list;
     }
     default:
-      throw InputError("parameter '" + name +
-                       "': unsupported type (a number, bool, string or list)");
+      throw SettingsError(
+          "", name, "parameter '" + name + "': unsupported type (a number, bool, string or list)");
   }
 }
 
-std::string check(const WrapperSettings& s) {
-  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
-  if (s.target_file.empty()) return "target_file is required (a Kalibr target YAML)";
-  if (!positive(s.status_period_s)) return bad("status_period_s", s.status_period_s);
-  return "";
+/// The wrapper's ranges, then its one rule: target_file is required.
+void check(const std::string& source, const WrapperSettings& s) {
+  throwIfProblem(source, checkRanges(keys(), s));
+  if (s.target_file.empty()) {
+    throw SettingsError(source, "target_file", "target_file is required (a Kalibr target YAML)");
+  }
 }
 
 }  // namespace
@@ -108,9 +99,10 @@ std::vector<std::string> resolvePaths(WrapperSettings* settings) {
   const fs::path target_abs = fs::absolute(target, error);
   if (!fs::is_regular_file(target_abs, error)) {
     const bool relative = fs::path(target).is_relative();
-    throw InputError("target_file '" + settings->target_file + "': no such file: tried " +
-                     target_abs.string() +
-                     (relative ? "; " + where + ": give an absolute path" : ""));
+    throw SettingsError("", "target_file",
+                        "target_file '" + settings->target_file + "': no such file: tried " +
+                            target_abs.string() +
+                            (relative ? "; " + where + ": give an absolute path" : ""));
   }
   settings->target_file = target_abs.string();
   if (!settings->output_file.empty()) {
@@ -124,6 +116,8 @@ std::vector<std::string> resolvePaths(WrapperSettings* settings) {
   }
   return notices;
 }
+
+const std::vector<SettingKey<WrapperSettings>>& wrapperKeyTable() { return keys(); }
 
 const std::vector<std::string>& wrapperKeys() {
   static const std::vector<std::string> names = keyNames(keys());
@@ -141,15 +135,11 @@ void parseSettings(const YAML::Node& root, const std::string& source, WrapperSet
       [&](const std::string& name, const YAML::Node& value) {
         const Key* key = findKey(keys(), name);
         if (!key) return false;
-        try {
-          key->read(value, &updated);
-        } catch (const YAML::Exception&) {
-          throw InputError(badValueMessage(source, name, yamlText(value), key->allowed));
-        }
+        readKey(*key, source, value, &updated);
         return true;
-      });
-  const std::string error = check(updated);
-  if (!error.empty()) throw InputError(source + ": " + error);
+      },
+      wrapperKeys());
+  check(source, updated);
   *wrapper = updated;
   *pipeline = updated_pipeline;
 }

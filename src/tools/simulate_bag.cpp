@@ -24,69 +24,12 @@
 #include "camera_imu_alignment/simulation/target.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "cli_args.h"
+#include "simulate_bag_options.h"
 
 namespace cia = camera_imu_alignment;
 namespace sim = camera_imu_alignment::simulation;
 
 namespace {
-
-const std::set<std::string> kValueOptions = {"--out",
-                                             "--seed",
-                                             "--scenario",
-                                             "--imu-grade",
-                                             "--num-poses",
-                                             "--hold-min-s",
-                                             "--hold-max-s",
-                                             "--move-min-s",
-                                             "--move-max-s",
-                                             "--motion",
-                                             "--max-tilt-deg",
-                                             "--max-roll-deg",
-                                             "--r-cam-imu",
-                                             "--imu-rate-hz",
-                                             "--mag-rate-hz",
-                                             "--camera-rate-hz",
-                                             "--noise-scale",
-                                             "--gyro-noise-density",
-                                             "--gyro-random-walk",
-                                             "--accel-noise-density",
-                                             "--accel-random-walk",
-                                             "--mag-noise-ut",
-                                             "--earth-field-ut",
-                                             "--mag-hard-iron-ut",
-                                             "--mag-disturbance-poses",
-                                             "--mag-disturbance-ut",
-                                             "--camera-time-offset-s",
-                                             "--remount-time-s",
-                                             "--remount-deg",
-                                             "--target",
-                                             "--target-cols",
-                                             "--target-rows",
-                                             "--target-spacing-m",
-                                             "--tag-spacing",
-                                             "--width",
-                                             "--height",
-                                             "--fx",
-                                             "--fy",
-                                             "--cx",
-                                             "--cy",
-                                             "--distortion",
-                                             "--blur-sigma-px",
-                                             "--pixel-noise",
-                                             "--supersample",
-                                             "--motion-blur-s",
-                                             "--imu-topic",
-                                             "--mag-topic",
-                                             "--image-topic",
-                                             "--camera-info-topic",
-                                             "--imu-frame",
-                                             "--camera-frame",
-                                             "--mag-frame",
-                                             "--mag-frame-yaw-deg",
-                                             "--start-time-s",
-                                             "--compression"};
-const std::set<std::string> kFlags = {"--help",      "-h",        "--no-magnetometer",
-                                      "--bad-input", "--remount", "--asymmetric-grid"};
 
 std::string usage() {
   std::ostringstream o;
@@ -98,176 +41,9 @@ std::string usage() {
   for (const auto& s : sim::scenarioList()) o << "  " << s.first << ": " << s.second << "\n";
   o << "IMU grades (--imu-grade NAME; after the scenario, before the noise options below):\n";
   for (const auto& g : sim::imuGradeList()) o << "  " << g.first << ": " << g.second << "\n";
-  o << "Options (defaults of the nominal scenario):\n"
-       "  --num-poses N (12)   --hold-min-s/--hold-max-s S (3/5)   --move-min-s/--move-max-s S "
-       "(2/3)\n"
-       "  --motion full|single_axis|small_angle   --max-tilt-deg (35)   --max-roll-deg (80)\n"
-       "  --r-cam-imu qx,qy,qz,qw (random per seed)   --remount [--remount-time-s T] "
-       "[--remount-deg x,y,z (0,10,0)]\n"
-       "  --imu-rate-hz (200)  --mag-rate-hz (100)  --camera-rate-hz (15)  --noise-scale (1)\n"
-       "  --gyro-noise-density (1.87e-4)  --gyro-random-walk (2.66e-5)  --accel-noise-density "
-       "(1.86e-3)\n"
-       "  --accel-random-walk (4.33e-4)  --mag-noise-ut (0.3)  --earth-field-ut x,y,z "
-       "(0,22,-42)\n"
-       "  --mag-hard-iron-ut x,y,z  --mag-disturbance-poses i,j  --mag-disturbance-ut (25)  "
-       "--no-magnetometer\n"
-       "  --camera-time-offset-s (0)  --bad-input\n"
-       "  --target checkerboard|aprilgrid|circlegrid  --target-cols/--target-rows N  "
-       "--target-spacing-m M\n"
-       "  --tag-spacing R (0.3)  --asymmetric-grid\n"
-       "  --width (640) --height (480) --fx --fy (500) --cx --cy (centre)  --distortion "
-       "k1,k2,p1,p2,k3\n"
-       "  --blur-sigma-px (0.6)  --pixel-noise (1.5)  --supersample (3)  --motion-blur-s (0)\n"
-       "  --imu-topic (imu/data_raw) --mag-topic (imu/mag) --image-topic (camera/image_raw)\n"
-       "  --camera-info-topic (camera/camera_info) --imu-frame (imu_link) --camera-frame "
-       "(camera_optical_frame)\n"
-       "  --mag-frame NAME --mag-frame-yaw-deg D (IMU frame, 0): magnetometer messages in frame "
-       "NAME,\n"
-       "    whose axes are the IMU's turned by D about its z; the rotation goes to /tf_static\n"
-       "  --start-time-s (1700000000)  --compression none|lz4|bz2 (none)\n";
+  o << "Options ((allowed, unit): what it sets [default of the nominal scenario]):\n"
+    << cia::simulateBagOptionsUsage();
   return o.str();
-}
-
-std::vector<double> parseList(const cia::CliArgs& args, const std::string& name, size_t n) {
-  std::vector<double> v;
-  std::stringstream ss(args.get(name));
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    char* end = nullptr;
-    const double x = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !std::isfinite(x)) {
-      throw cia::UsageError(name + ": '" + item + "' is not a number");
-    }
-    v.push_back(x);
-  }
-  if (n > 0 && v.size() != n) {
-    throw cia::UsageError(name + " needs " + std::to_string(n) + " comma-separated numbers");
-  }
-  return v;
-}
-
-Eigen::Vector3d vec3(const cia::CliArgs& args, const std::string& name, double scale) {
-  const std::vector<double> v = parseList(args, name, 3);
-  return scale * Eigen::Vector3d(v[0], v[1], v[2]);
-}
-
-sim::SimulationConfig configFromArgs(const cia::CliArgs& a) {
-  sim::SimulationConfig c;
-  c.seed = static_cast<std::uint64_t>(a.getInt("--seed", 1, 0, std::numeric_limits<long>::max()));
-  const std::string scenario = a.get("--scenario", "nominal");
-  if (!sim::applyScenario(scenario, &c)) {
-    throw cia::UsageError("--scenario: unknown scenario '" + scenario + "' (see --help)");
-  }
-  if (a.has("--imu-grade")) {
-    sim::ImuGrade grade;
-    if (!sim::parseImuGrade(a.get("--imu-grade"), &grade)) {
-      throw cia::UsageError("--imu-grade must be ideal, tactical, consumer or noisy, got '" +
-                            a.get("--imu-grade") + "'");
-    }
-    sim::applyImuGrade(grade, &c);
-  }
-  c.num_poses = static_cast<int>(a.getInt("--num-poses", c.num_poses, 2, 1000));
-  c.hold_min_s = a.getDouble("--hold-min-s", c.hold_min_s, 0.1, 600);
-  c.hold_max_s = a.getDouble("--hold-max-s", std::max(c.hold_max_s, c.hold_min_s), 0.1, 600);
-  c.move_min_s = a.getDouble("--move-min-s", c.move_min_s, 0.2, 600);
-  c.move_max_s = a.getDouble("--move-max-s", std::max(c.move_max_s, c.move_min_s), 0.2, 600);
-  if (a.has("--motion")) {
-    const std::string m = a.get("--motion");
-    if (m == "full") {
-      c.motion = sim::MotionKind::kFull;
-    } else if (m == "single_axis") {
-      c.motion = sim::MotionKind::kSingleAxis;
-    } else if (m == "small_angle") {
-      c.motion = sim::MotionKind::kSmallAngle;
-    } else {
-      throw cia::UsageError("--motion must be full, single_axis or small_angle, got '" + m + "'");
-    }
-  }
-  c.max_tilt_deg = a.getDouble("--max-tilt-deg", c.max_tilt_deg, 0, 60);
-  c.max_roll_deg = a.getDouble("--max-roll-deg", c.max_roll_deg, 0, 180);
-  if (a.has("--r-cam-imu")) {
-    const std::vector<double> q = parseList(a, "--r-cam-imu", 4);
-    const Eigen::Quaterniond quat(q[3], q[0], q[1], q[2]);
-    if (std::abs(quat.norm() - 1.0) > 1e-3) {
-      throw cia::UsageError("--r-cam-imu must be a unit quaternion qx,qy,qz,qw");
-    }
-    c.given_R_cam_imu = true;
-    c.R_cam_imu = quat.normalized().toRotationMatrix();
-  }
-  c.imu_rate_hz = a.getDouble("--imu-rate-hz", c.imu_rate_hz, 1, 10000);
-  c.mag_rate_hz = a.getDouble("--mag-rate-hz", c.mag_rate_hz, 1, 10000);
-  c.camera_rate_hz = a.getDouble("--camera-rate-hz", c.camera_rate_hz, 0.1, 200);
-  c.noise_scale = a.getDouble("--noise-scale", c.noise_scale, 0, 1000);
-  sim::SensorNoise& n = c.imu_noise;
-  n.gyroscope_noise_density = a.getDouble("--gyro-noise-density", n.gyroscope_noise_density, 0, 1);
-  n.gyroscope_random_walk = a.getDouble("--gyro-random-walk", n.gyroscope_random_walk, 0, 1);
-  n.accelerometer_noise_density =
-      a.getDouble("--accel-noise-density", n.accelerometer_noise_density, 0, 10);
-  n.accelerometer_random_walk =
-      a.getDouble("--accel-random-walk", n.accelerometer_random_walk, 0, 10);
-  n.magnetometer_noise_sigma =
-      1e-6 * a.getDouble("--mag-noise-ut", 1e6 * n.magnetometer_noise_sigma, 0, 100);
-  if (a.has("--earth-field-ut")) c.earth_field_world = vec3(a, "--earth-field-ut", 1e-6);
-  if (a.has("--mag-hard-iron-ut")) c.mag_hard_iron = vec3(a, "--mag-hard-iron-ut", 1e-6);
-  if (a.has("--mag-disturbance-poses")) {
-    c.mag_disturbance_poses.clear();
-    for (double p : parseList(a, "--mag-disturbance-poses", 0)) {
-      if (p != std::floor(p) || p < 0 || p >= c.num_poses) {
-        throw cia::UsageError("--mag-disturbance-poses: pose " + std::to_string(p) +
-                              " is not an index in [0, num_poses)");
-      }
-      c.mag_disturbance_poses.push_back(static_cast<int>(p));
-    }
-  }
-  c.mag_disturbance_t =
-      1e-6 * a.getDouble("--mag-disturbance-ut", 1e6 * c.mag_disturbance_t, 0, 1000);
-  if (a.has("--no-magnetometer")) c.magnetometer = false;
-  c.camera_time_offset_s = a.getDouble("--camera-time-offset-s", c.camera_time_offset_s, -10, 10);
-  if (a.has("--remount") || a.has("--remount-time-s") || a.has("--remount-deg")) c.remount = true;
-  c.remount_time_s = a.getDouble("--remount-time-s", c.remount_time_s, 0, 1e6);
-  if (a.has("--remount-deg")) c.remount_rotvec_cam = vec3(a, "--remount-deg", cia::kPi / 180.0);
-  if (a.has("--bad-input")) c.bad_input = true;
-  if (a.has("--target")) {
-    const std::string t = a.get("--target");
-    if (t != "checkerboard" && t != "aprilgrid" && t != "circlegrid") {
-      throw cia::UsageError("--target must be checkerboard, aprilgrid or circlegrid, got '" + t +
-                            "'");
-    }
-    if (t != sim::toString(c.target.type)) {
-      sim::SimulationConfig preset;  // the default target of that type
-      sim::applyScenario(t == "checkerboard" ? "nominal" : t, &preset);
-      c.target = preset.target;
-    }
-  }
-  c.target.cols = static_cast<int>(a.getInt("--target-cols", c.target.cols, 2, 50));
-  c.target.rows = static_cast<int>(a.getInt("--target-rows", c.target.rows, 2, 50));
-  c.target.spacing_m = a.getDouble("--target-spacing-m", c.target.spacing_m, 0.001, 1);
-  c.target.tag_spacing = a.getDouble("--tag-spacing", c.target.tag_spacing, 0.05, 1);
-  if (a.has("--asymmetric-grid")) c.target.asymmetric_grid = true;
-  c.width = static_cast<int>(a.getInt("--width", c.width, 16, 4096));
-  c.height = static_cast<int>(a.getInt("--height", c.height, 16, 4096));
-  c.fx = a.getDouble("--fx", c.fx, 1, 1e5);
-  c.fy = a.getDouble("--fy", c.fy, 1, 1e5);
-  c.cx = a.getDouble("--cx", 0.5 * (c.width - 1), -1e4, 1e4);
-  c.cy = a.getDouble("--cy", 0.5 * (c.height - 1), -1e4, 1e4);
-  if (a.has("--distortion")) {
-    const std::vector<double> d = parseList(a, "--distortion", 5);
-    std::copy(d.begin(), d.end(), c.distortion.begin());
-  }
-  c.blur_sigma_px = a.getDouble("--blur-sigma-px", c.blur_sigma_px, 0, 10);
-  c.pixel_noise_sigma = a.getDouble("--pixel-noise", c.pixel_noise_sigma, 0, 100);
-  c.supersample = static_cast<int>(a.getInt("--supersample", c.supersample, 1, 8));
-  c.motion_blur_exposure_s = a.getDouble("--motion-blur-s", c.motion_blur_exposure_s, 0, 1);
-  c.imu_topic = a.get("--imu-topic", c.imu_topic);
-  c.mag_topic = a.get("--mag-topic", c.mag_topic);
-  c.image_topic = a.get("--image-topic", c.image_topic);
-  c.camera_info_topic = a.get("--camera-info-topic", c.camera_info_topic);
-  c.imu_frame = a.get("--imu-frame", c.imu_frame);
-  c.camera_frame = a.get("--camera-frame", c.camera_frame);
-  c.start_time_s = a.getDouble("--start-time-s", c.start_time_s, 1, 4e9);
-  const std::string problems = sim::validateConfig(c);
-  if (!problems.empty()) throw cia::UsageError(problems);
-  return c;
 }
 
 void writeText(const std::string& path, const std::string& text) {
@@ -304,12 +80,7 @@ sensor_msgs::CameraInfo cameraInfo(const sim::SimulationConfig& c) {
 
 }  // namespace
 
-/// How the bag is written (beyond the simulation itself).
-struct BagOptions {
-  std::string compression = "none";  ///< none, lz4 or bz2
-  std::string mag_frame;             ///< frame_id of the magnetometer; empty: the IMU's
-  double mag_frame_yaw_rad = 0.0;    ///< R_imu_mag = rotation about the IMU's z by this angle
-};
+using cia::BagOptions;
 
 /// The static transform imu_frame -> mag_frame (rotation R_imu_mag: magnetometer axes to IMU axes).
 tf2_msgs::TFMessage magnetometerTf(const sim::SimulationConfig& c, const BagOptions& o) {
@@ -463,30 +234,15 @@ int writeBag(const sim::SimulationRun& run, const std::string& path, const BagOp
 
 int main(int argc, char** argv) {
   try {
-    const cia::CliArgs args(argc, argv, kValueOptions, kFlags);
+    const cia::CliArgs args(argc, argv, cia::simulateBagValueOptions(), cia::simulateBagFlags());
     if (args.has("--help") || args.has("-h")) {
       std::cout << usage();
       return 0;
     }
-    if (!args.has("--out")) throw cia::UsageError("--out FILE.bag is required");
-    const std::string out = args.get("--out");
-    if (out.size() < 5 || out.compare(out.size() - 4, 4, ".bag") != 0) {
-      throw cia::UsageError("--out must name a file ending in .bag, got '" + out + "'");
-    }
-    BagOptions bag_options;
-    bag_options.compression = args.get("--compression", "none");
-    if (bag_options.compression != "none" && bag_options.compression != "lz4" &&
-        bag_options.compression != "bz2") {
-      throw cia::UsageError("--compression must be none, lz4 or bz2");
-    }
-    bag_options.mag_frame = args.get("--mag-frame", "");
-    bag_options.mag_frame_yaw_rad =
-        cia::deg2rad(args.getDouble("--mag-frame-yaw-deg", 0.0, -360.0, 360.0));
-    const sim::SimulationConfig config = configFromArgs(args);
-    if (bag_options.mag_frame_yaw_rad != 0.0 &&
-        (bag_options.mag_frame.empty() || bag_options.mag_frame == config.imu_frame)) {
-      throw cia::UsageError("--mag-frame-yaw-deg needs a --mag-frame other than the IMU's frame");
-    }
+    const cia::SimulateBagOptions options = cia::parseSimulateBagOptions(args);
+    const std::string& out = options.out;
+    const BagOptions& bag_options = options.bag;
+    const sim::SimulationConfig& config = options.config;
     const auto start = std::chrono::steady_clock::now();
     const sim::SimulationRun run(config);
     const std::string base = out.substr(0, out.size() - 4);
@@ -502,6 +258,9 @@ int main(int argc, char** argv) {
               << "simulate_bag: wrote " << base << ".truth.yaml and " << base << ".target.yaml\n";
     return 0;
   } catch (const cia::UsageError& e) {
+    std::cerr << "simulate_bag: " << e.what() << "\n" << usage();
+    return 2;
+  } catch (const cia::SettingsError& e) {
     std::cerr << "simulate_bag: " << e.what() << "\n" << usage();
     return 2;
   } catch (const std::exception& e) {

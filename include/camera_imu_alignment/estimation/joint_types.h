@@ -116,10 +116,13 @@ struct JointSettings {
   int max_iterations = 50;       ///< Levenberg-Marquardt iterations per solve
   int max_relinearisations = 5;  ///< gyro preintegration passes (outer loop), >= 2
   MagnetometerUse use_magnetometer = MagnetometerUse::kAuto;
+  /// Local gravity (m/s^2) of the accelerometer model. The pipeline sets it from the setting
+  /// gravity_m_s2 (jointSettingsOf in calibration_pipeline.h), as the stationary detector's.
   double gravity_m_s2 = 9.81;
-  /// The estimate is refused (ok = false) when its 1-sigma about a camera axis exceeds this (deg):
-  /// the poses do not determine R_cam_imu (e.g. no rotation between them).
-  double max_std_dev_deg = 10.0;
+  /// The estimate is refused (ok = false, "R_cam_imu is not determined") when its 1-sigma about a
+  /// camera axis exceeds this (deg): the poses do not determine R_cam_imu (e.g. no rotation
+  /// between them). Not a setting key; far above the broadcast gate (the key max_std_dev_deg).
+  double undetermined_std_dev_deg = 10.0;
   /// False: the fit alone (R_cam_imu, R_cam_imu_after_change, chi2, dof, p-value, per-pose
   /// residuals); no covariance (zero 1-sigma), no IMU parameters. For callers that compare fits
   /// (the mount-change test needs its chi-square drops only; the covariance is about a tenth of

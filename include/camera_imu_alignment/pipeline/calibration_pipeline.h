@@ -98,6 +98,11 @@ struct PipelineSettings {
   std::string validate() const;
 };
 
+/// The joint estimate's settings as the pipeline uses them: `settings.joint` with the local
+/// gravity of the setting gravity_m_s2 (stationary.gravity_m_s2), so that one value feeds the
+/// stationary detector and the joint estimate's accelerometer model alike.
+JointSettings jointSettingsOf(const PipelineSettings& settings);
+
 /// Where a pose's R_world_imu came from (the rule above).
 enum class PoseImuSource {
   kGyro,       ///< the gyro chain
@@ -171,7 +176,7 @@ class CalibrationPipeline : public SampleSink {
   /// for days must not grow); the totals count all.
   static constexpr std::size_t kHistoryLimit = 1000;
 
-  /// Throws std::invalid_argument when settings.validate() fails.
+  /// Throws SettingsError (an std::invalid_argument) when settings.validate() fails.
   CalibrationPipeline(const TargetDescription& target, const PipelineSettings& settings,
                       PipelineCallbacks callbacks = {});
   ~CalibrationPipeline();

@@ -34,7 +34,7 @@ std::string expandHome(const std::string& path);
 
 /// At start: expands "~" in target_file and output_file and makes them absolute. A relative path
 /// resolves from the node's working directory, which under roslaunch is ROS_HOME (~/.ros), not
-/// where the user typed the command: a missing target file is an InputError naming the
+/// where the user typed the command: a missing target file is a SettingsError naming the
 /// parameter, the path given, that rule and the absolute path tried. Returns notices for the log
 /// (a relative output_file: where it will be written).
 std::vector<std::string> resolvePaths(WrapperSettings* settings);
@@ -42,10 +42,13 @@ std::vector<std::string> resolvePaths(WrapperSettings* settings);
 /// The wrapper's own keys (the calibrator's are onlineConfigKeys(), the pipeline's
 /// pipelineConfigKeys()).
 const std::vector<std::string>& wrapperKeys();
+/// Their table (setting_keys.h).
+const std::vector<SettingKey<WrapperSettings>>& wrapperKeyTable();
 
 /// Reads the private parameters of `private_nh`: wrapper keys into `wrapper`, pipeline keys into
-/// `pipeline` (same reader and checks as calibrate_bag --config). Throws InputError naming the
-/// parameter on an unknown key, a wrong type or an unusable value.
+/// `pipeline` (same reader and checks as calibrate_bag --config). Throws SettingsError naming the
+/// parameter on an unknown key (with "did you mean" the closest key), a wrong type or an
+/// unusable value.
 void readSettings(const ros::NodeHandle& private_nh, WrapperSettings* wrapper,
                   PipelineSettings* pipeline);
 

@@ -1,93 +1,111 @@
-// The calibrator's setting keys (online_config.h).
+// The calibrator's setting keys (online_config.h): one table, one entry per key; its ranges are
+// OnlineSettings::validate()'s.
 #include "camera_imu_alignment/config/online_config.h"
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
 #include "camera_imu_alignment/config/pipeline_config.h"
-#include "camera_imu_alignment/io/input_error.h"
+#include "camera_imu_alignment/config/settings_checks.h"
 
 namespace camera_imu_alignment {
 namespace {
 
 using Key = SettingKey<OnlineSettings>;
 
-template <typename T, typename Access>
-Key field(const std::string& name, Access access, const std::string& allowed) {
-  return fieldKey<T, OnlineSettings>(name, access, allowed);
-}
+/// The member `path` of an OnlineSettings (const or not).
+#define CIA_MEMBER(path) \
+  [](auto& s) -> auto& { return s.path; }
 
-const char* const kPositive = "a finite number > 0";
-const char* const kProbability = "a number within (0, 1)";
+template <typename T, typename Access>
+Key number(const std::string& name, Access access, SettingRange range, const std::string& unit,
+           const std::string& description) {
+  return numberKey<T, OnlineSettings>(name, access, range, unit, description);
+}
 
 }  // namespace
 
 const std::vector<Key>& onlineKeys() {
+  const SettingRange positive = above(0.0);
+  const SettingRange probability = between(0.0, 1.0);
   static const std::vector<Key> table = {
-      field<int>(
-          "min_poses", [](OnlineSettings* s) { return &s->min_poses; }, "an integer >= 2"),
-      field<double>(
-          "max_std_dev_deg", [](OnlineSettings* s) { return &s->max_std_dev_deg; }, kPositive),
-      field<double>(
-          "consistency_level", [](OnlineSettings* s) { return &s->consistency_level; },
-          kProbability),
-      field<double>(
-          "max_residual_deg", [](OnlineSettings* s) { return &s->max_residual_deg; }, kPositive),
-      field<double>(
-          "min_change_deg", [](OnlineSettings* s) { return &s->min_change_deg; },
-          "a finite number >= 0"),
-      field<bool>(
-          "manual_capture", [](OnlineSettings* s) { return &s->manual_capture; }, "true or false"),
-      field<double>(
-          "remount_level", [](OnlineSettings* s) { return &s->remount.level; }, kProbability),
-      field<int>(
-          "remount_min_poses_after", [](OnlineSettings* s) { return &s->remount.min_poses_after; },
-          "an integer >= 2"),
-      field<int>(
-          "remount_max_poses_after", [](OnlineSettings* s) { return &s->remount.max_poses_after; },
-          "an integer >= remount_min_poses_after"),
-      field<int>(
-          "remount_min_poses_before",
-          [](OnlineSettings* s) { return &s->remount.min_poses_before; }, "an integer >= 2"),
-      field<int>(
-          "remount_poses", [](OnlineSettings* s) { return &s->remount_poses; }, "an integer >= 1"),
-      field<double>(
-          "remount_residual_deg", [](OnlineSettings* s) { return &s->remount_residual_deg; },
-          kPositive),
+      number<int>("min_poses", CIA_MEMBER(min_poses), atLeast(2), "",
+                  "gate: stationary poses in the window before broadcasting"),
+      number<double>("max_std_dev_deg", CIA_MEMBER(max_std_dev_deg), positive, "deg",
+                     "gate: largest 1-sigma about a camera axis of a broadcast estimate"),
+      number<double>("consistency_level", CIA_MEMBER(consistency_level), probability, "",
+                     "gate (joint estimate): its chi-square p-value must be >= this"),
+      number<double>("max_residual_deg", CIA_MEMBER(max_residual_deg), positive, "deg",
+                     "gate (imu_orientation auto or message): RMS pair residual"),
+      number<double>("min_change_deg", CIA_MEMBER(min_change_deg), atLeast(0.0), "deg",
+                     "re-broadcast only when the estimate moved more than this"),
+      boolKey<OnlineSettings>("manual_capture", CIA_MEMBER(manual_capture),
+                              "true: a rest becomes a pose only after ~capture_pose"),
+      number<double>("remount_level", CIA_MEMBER(remount.level), probability, "",
+                     "remount test: false-alarm probability per test"),
+      number<int>("remount_min_poses_after", CIA_MEMBER(remount.min_poses_after), atLeast(2), "",
+                  "remount test: poses of the new mount needed"),
+      number<int>("remount_max_poses_after", CIA_MEMBER(remount.max_poses_after), atLeast(2), "",
+                  "remount test: the newest this many poses are candidate first poses"),
+      number<int>("remount_min_poses_before", CIA_MEMBER(remount.min_poses_before), atLeast(2), "",
+                  "remount test: poses of the old mount needed"),
+      number<int>("remount_poses", CIA_MEMBER(remount_poses), atLeast(1), "",
+                  "pair modes: consecutive disagreeing poses that restart the window"),
+      number<double>("remount_residual_deg", CIA_MEMBER(remount_residual_deg), positive, "deg",
+                     "pair modes: RMS disagreement of a pose with the broadcast estimate"),
   };
   return table;
 }
+
+#undef CIA_MEMBER
 
 const std::vector<std::string>& onlineConfigKeys() {
   static const std::vector<std::string> names = keyNames(onlineKeys());
   return names;
 }
 
+std::optional<SettingProblem> findProblem(const OnlineSettings& settings) {
+  if (auto problem = checkRanges(onlineKeys(), settings)) return problem;
+  return checkAcrossKeys(nullptr, &settings);
+}
+
+std::optional<SettingProblem> findProblem(const PipelineSettings& pipeline,
+                                          const OnlineSettings& online) {
+  if (auto problem = checkRanges(pipelineKeys(), pipeline)) return problem;
+  if (auto problem = checkRanges(onlineKeys(), online)) return problem;
+  return checkAcrossKeys(&pipeline, &online);
+}
+
+std::string OnlineSettings::validate() const {
+  const std::optional<SettingProblem> problem = findProblem(*this);
+  return problem ? problem->message : "";
+}
+
 void parseCalibrationConfig(
     const YAML::Node& root, const std::string& source, PipelineSettings* pipeline,
     OnlineSettings* online,
-    const std::function<bool(const std::string&, const YAML::Node&)>& handled) {
+    const std::function<bool(const std::string&, const YAML::Node&)>& handled,
+    const std::vector<std::string>& other_keys) {
   PipelineSettings updated_pipeline = *pipeline;
   OnlineSettings updated_online = *online;
   if (root.IsMap()) {
     for (const auto& entry : root) {
       const std::string name = entry.first.as<std::string>();
       if (handled && handled(name, entry.second)) continue;
-      const Key* key = findKey(onlineKeys(), name);
-      if (!key) {
+      if (const Key* key = findKey(onlineKeys(), name)) {
+        readKey(*key, source, entry.second, &updated_online);
+      } else if (findKey(pipelineKeys(), name)) {
         readPipelineKey(source, name, entry.second, &updated_pipeline);
-        continue;
-      }
-      try {
-        key->read(entry.second, &updated_online);
-      } catch (const YAML::Exception&) {
-        throw InputError(badValueMessage(source, name, yamlText(entry.second), key->allowed));
+      } else {
+        std::vector<std::string> known = pipelineConfigKeys();
+        known.insert(known.end(), onlineConfigKeys().begin(), onlineConfigKeys().end());
+        known.insert(known.end(), other_keys.begin(), other_keys.end());
+        throw SettingsError(source, name, unknownKeyMessage(name, known));
       }
     }
   }
-  checkPipelineSettings(source, updated_pipeline);
-  const std::string error = updated_online.validate();
-  if (!error.empty()) throw InputError(source + ": " + error);
+  throwIfProblem(source, findProblem(updated_pipeline, updated_online));
   *pipeline = updated_pipeline;
   *online = updated_online;
 }
@@ -100,9 +118,11 @@ void loadCalibrationConfig(const std::string& path, PipelineSettings* pipeline,
   buffer << in.rdbuf();
   const YAML::Node root = parseSettingsYaml(buffer.str(), path);
   parseCalibrationConfig(
-      root, path, pipeline, online, [&](const std::string& name, const YAML::Node&) {
+      root, path, pipeline, online,
+      [&](const std::string& name, const YAML::Node&) {
         return std::find(ignored_keys.begin(), ignored_keys.end(), name) != ignored_keys.end();
-      });
+      },
+      ignored_keys);
 }
 
 }  // namespace camera_imu_alignment

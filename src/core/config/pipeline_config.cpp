@@ -1,3 +1,6 @@
+// The pipeline's keys (pipeline_config.h): one table, one entry per key. Its ranges are
+// PipelineSettings::validate()'s; config/default.yaml holds the same keys with the struct's
+// defaults (test_pipeline_config checks both directions).
 #include "camera_imu_alignment/config/pipeline_config.h"
 
 #include <yaml-cpp/yaml.h>
@@ -7,178 +10,192 @@
 #include <fstream>
 #include <sstream>
 
-#include "camera_imu_alignment/io/input_error.h"
+#include "camera_imu_alignment/config/settings_checks.h"
 
 namespace camera_imu_alignment {
 namespace {
 
 using Key = SettingKey<PipelineSettings>;
 
+/// The member `path` of a PipelineSettings (const or not).
+#define CIA_MEMBER(path) \
+  [](auto& s) -> auto& { return s.path; }
+
 template <typename T, typename Access>
-Key number(const std::string& name, Access access, const std::string& allowed) {
-  return fieldKey<T, PipelineSettings>(name, access, allowed);
+Key number(const std::string& name, Access access, SettingRange range, const std::string& unit,
+           const std::string& description) {
+  return numberKey<T, PipelineSettings>(name, access, range, unit, description);
 }
 
-// The ranges PipelineSettings::validate() applies, as told in messages.
-const char* const kPositive = "a finite number > 0";
-const char* const kNonNegative = "a finite number >= 0";
+/// A list of `N` finite numbers in YAML flow style, written into `set`; `valid` judges the whole.
+template <int N, typename Get, typename Set, typename Valid>
+Key numberList(const std::string& name, Get get, Set set, Valid valid, const std::string& allowed,
+               const std::string& unit, const std::string& description) {
+  return {name,
+          unit,
+          description,
+          allowed,
+          [set](const YAML::Node& node, PipelineSettings* s) {
+            const auto v = node.as<std::vector<double>>();
+            if (v.size() != N) throw YAML::Exception(node.Mark(), "wrong length");
+            set(v, s);
+          },
+          allowed,
+          valid,
+          [get](const PipelineSettings& s) {
+            std::string text = "[";
+            const std::vector<double> v = get(s);
+            for (std::size_t i = 0; i < v.size(); ++i) {
+              text += (i ? ", " : "") + formatSettingNumber(v[i]);
+            }
+            return text + "]";
+          },
+          std::nullopt,
+          false};
+}
 
 const std::vector<Key>& keys() {
+  const SettingRange positive = above(0.0);
+  const SettingRange non_negative = atLeast(0.0);
   static const std::vector<Key> table = {
       // Stationary detection (IMU).
-      number<double>(
-          "stationary_window_s", [](auto* s) { return &s->stationary.window_s; }, kPositive),
-      number<double>(
-          "min_stationary_duration_s", [](auto* s) { return &s->stationary.min_duration_s; },
-          kPositive),
-      number<double>(
-          "max_gyro_std_rad_s", [](auto* s) { return &s->stationary.max_gyro_std_rad_s; },
-          kPositive),
-      number<double>(
-          "max_accel_std_m_s2", [](auto* s) { return &s->stationary.max_accel_std_m_s2; },
-          kPositive),
-      number<double>(
-          "stationary_noise_factor", [](auto* s) { return &s->stationary.noise_factor; },
-          kNonNegative),
-      number<double>(
-          "max_gyro_change_rad_s", [](auto* s) { return &s->stationary.max_gyro_change_rad_s; },
-          kPositive),
-      number<double>(
-          "max_gravity_turn_rate_rad_s",
-          [](auto* s) { return &s->stationary.max_gravity_turn_rate_rad_s; }, kPositive),
-      number<double>(
-          "stationary_change_noise_factor",
-          [](auto* s) { return &s->stationary.change_noise_factor; }, kNonNegative),
-      number<double>(
-          "max_gyro_bias_rad_s", [](auto* s) { return &s->stationary.max_gyro_bias_rad_s; },
-          kPositive),
-      number<double>(
-          "max_rate_about_gravity_rad_s",
-          [](auto* s) { return &s->stationary.max_rate_about_gravity_rad_s; }, kPositive),
-      number<double>(
-          "max_gravity_error_m_s2", [](auto* s) { return &s->stationary.max_gravity_error_m_s2; },
-          kPositive),
-      number<double>(
-          "gravity_m_s2", [](auto* s) { return &s->stationary.gravity_m_s2; }, kPositive),
-      number<double>(
-          "max_imu_gap_s", [](auto* s) { return &s->stationary.max_gap_s; }, kPositive),
-      number<double>(
-          "max_gyro_span_s", [](auto* s) { return &s->max_gyro_span_s; }, kPositive),
-      // IMU orientation.
-      {"imu_orientation",
-       [](const YAML::Node& node, PipelineSettings* s) {
-         if (!parseImuOrientationSource(node.as<std::string>(), &s->imu_orientation)) {
-           throw YAML::Exception(node.Mark(), "unknown source");
-         }
-       },
-       "'joint', 'auto', 'magnetometer' or 'message'"},
-      number<double>(
-          "accel_weight", [](auto* s) { return &s->accel_weight; }, "a number within (0, 1)"),
-      {"imu_matrices",
-       [](const YAML::Node& node, PipelineSettings* s) {
-         if (!parseImuMatrixModel(node.as<std::string>(), &s->joint.imu_matrices)) {
-           throw YAML::Exception(node.Mark(), "unknown model");
-         }
-       },
-       "'select', 'estimate' or 'identity'"},
+      number<double>("stationary_window_s", CIA_MEMBER(stationary.window_s), positive, "s",
+                     "sliding window over which rest is judged"),
+      number<double>("min_stationary_duration_s", CIA_MEMBER(stationary.min_duration_s), positive,
+                     "s", "shortest rest that becomes a pose (after trimming)"),
+      number<double>("max_gyro_std_rad_s", CIA_MEMBER(stationary.max_gyro_std_rad_s), positive,
+                     "rad/s", "gyro scatter about the window mean at rest (floor)"),
+      number<double>("max_accel_std_m_s2", CIA_MEMBER(stationary.max_accel_std_m_s2), positive,
+                     "m/s^2", "std of |accel| over the window at rest (floor)"),
+      number<double>("stationary_noise_factor", CIA_MEMBER(stationary.noise_factor), non_negative,
+                     "", "the scatter limits rise to this x the measured sensor noise"),
+      number<double>("max_gyro_change_rad_s", CIA_MEMBER(stationary.max_gyro_change_rad_s),
+                     positive, "rad/s", "change of the mean gyro within a rest (floor)"),
+      number<double>("max_gravity_turn_rate_rad_s",
+                     CIA_MEMBER(stationary.max_gravity_turn_rate_rad_s), positive, "rad/s",
+                     "turn rate of the mean accel direction within a rest (floor)"),
+      number<double>("stationary_change_noise_factor", CIA_MEMBER(stationary.change_noise_factor),
+                     non_negative, "", "the change limits rise to this x their noise"),
+      number<double>("max_gyro_bias_rad_s", CIA_MEMBER(stationary.max_gyro_bias_rad_s), positive,
+                     "rad/s", "|window mean gyro| at any rest: the largest gyro bias"),
+      number<double>("max_rate_about_gravity_rad_s",
+                     CIA_MEMBER(stationary.max_rate_about_gravity_rad_s), positive, "rad/s",
+                     "rotation about gravity at rest, which the accelerometer cannot see"),
+      number<double>("max_gravity_error_m_s2", CIA_MEMBER(stationary.max_gravity_error_m_s2),
+                     positive, "m/s^2", "| |mean accel| - gravity | at rest"),
+      number<double>("gravity_m_s2", CIA_MEMBER(stationary.gravity_m_s2), positive, "m/s^2",
+                     "local gravity: the stationary detector and the joint estimate's model"),
+      number<double>("max_imu_gap_s", CIA_MEMBER(stationary.max_gap_s), positive, "s",
+                     "a longer gap between IMU samples ends a rest and the gyro chain"),
+      number<double>("max_gyro_span_s", CIA_MEMBER(max_gyro_span_s), positive, "s",
+                     "longer motion between two rests breaks the gyro chain"),
+      // How R_cam_imu is estimated.
+      wordKey<PipelineSettings>(
+          "imu_orientation", CIA_MEMBER(imu_orientation),
+          {"joint", "auto", "magnetometer", "message"}, parseImuOrientationSource,
+          [](ImuOrientationSource v) { return toString(v); },
+          "where the IMU's orientation at each pose comes from"),
+      number<double>("accel_weight", CIA_MEMBER(accel_weight), between(0.0, 1.0), "",
+                     "q-method weight of gravity against magnetic north"),
+      wordKey<PipelineSettings>(
+          "imu_matrices", CIA_MEMBER(joint.imu_matrices), {"select", "estimate", "identity"},
+          parseImuMatrixModel, [](ImuMatrixModel v) { return toString(v); },
+          "joint: the gyro's and accelerometer's matrices T_g, T_a"),
       // Joint estimate: 1-sigma of the priors on the IMU's errors.
-      number<double>(
-          "imu_prior_gyro_scale", [](auto* s) { return &s->joint.priors.gyro_scale; }, kPositive),
-      number<double>(
-          "imu_prior_gyro_cross_axis", [](auto* s) { return &s->joint.priors.gyro_cross_axis; },
-          kPositive),
-      number<double>(
-          "imu_prior_gyro_bias_walk_rad_s_sqrt_s",
-          [](auto* s) { return &s->joint.priors.gyro_bias_walk_rad_s_sqrt_s; }, kPositive),
-      number<double>(
-          "imu_prior_accel_scale", [](auto* s) { return &s->joint.priors.accel_scale; }, kPositive),
-      number<double>(
-          "imu_prior_accel_cross_axis", [](auto* s) { return &s->joint.priors.accel_cross_axis; },
-          kPositive),
-      number<double>(
-          "imu_prior_accel_bias_m_s2", [](auto* s) { return &s->joint.priors.accel_bias_m_s2; },
-          kPositive),
-      number<double>(
-          "imu_prior_accel_bias_walk_m_s2_sqrt_s",
-          [](auto* s) { return &s->joint.priors.accel_bias_walk_m_s2_sqrt_s; }, kPositive),
-      number<double>(
-          "imu_prior_soft_iron_scale", [](auto* s) { return &s->joint.priors.soft_iron_scale; },
-          kPositive),
-      number<double>(
-          "imu_prior_soft_iron_cross", [](auto* s) { return &s->joint.priors.soft_iron_cross; },
-          kPositive),
-      number<double>(
-          "imu_prior_hard_iron_t", [](auto* s) { return &s->joint.priors.hard_iron_t; }, kPositive),
+      number<double>("imu_prior_gyro_scale", CIA_MEMBER(joint.priors.gyro_scale), positive, "",
+                     "prior: gyro sensitivity error (fraction)"),
+      number<double>("imu_prior_gyro_cross_axis", CIA_MEMBER(joint.priors.gyro_cross_axis),
+                     positive, "", "prior: gyro cross-axis / misalignment (fraction)"),
+      number<double>("imu_prior_gyro_bias_walk_rad_s_sqrt_s",
+                     CIA_MEMBER(joint.priors.gyro_bias_walk_rad_s_sqrt_s), positive,
+                     "rad/s/sqrt(s)", "prior: gyro bias random walk between rests"),
+      number<double>("imu_prior_accel_scale", CIA_MEMBER(joint.priors.accel_scale), positive, "",
+                     "prior: accelerometer sensitivity error (fraction)"),
+      number<double>("imu_prior_accel_cross_axis", CIA_MEMBER(joint.priors.accel_cross_axis),
+                     positive, "", "prior: accelerometer non-orthogonality (fraction)"),
+      number<double>("imu_prior_accel_bias_m_s2", CIA_MEMBER(joint.priors.accel_bias_m_s2),
+                     positive, "m/s^2", "prior: accelerometer bias"),
+      number<double>("imu_prior_accel_bias_walk_m_s2_sqrt_s",
+                     CIA_MEMBER(joint.priors.accel_bias_walk_m_s2_sqrt_s), positive,
+                     "m/s^2/sqrt(s)", "prior: accelerometer bias random walk between rests"),
+      number<double>("imu_prior_soft_iron_scale", CIA_MEMBER(joint.priors.soft_iron_scale),
+                     positive, "", "prior: magnetometer soft iron, diagonal (fraction)"),
+      number<double>("imu_prior_soft_iron_cross", CIA_MEMBER(joint.priors.soft_iron_cross),
+                     positive, "", "prior: magnetometer soft iron, off-diagonal (fraction)"),
+      number<double>("imu_prior_hard_iron_t", CIA_MEMBER(joint.priors.hard_iron_t), positive, "T",
+                     "prior: magnetometer hard iron left after mag_hard_iron_t"),
       // Magnetometer.
-      number<double>(
-          "mag_scale", [](auto* s) { return &s->magnetometer.scale; }, kPositive),
-      {"mag_hard_iron_t",
-       [](const YAML::Node& node, PipelineSettings* s) {
-         const auto v = node.as<std::vector<double>>();
-         if (v.size() != 3) throw YAML::Exception(node.Mark(), "needs 3 numbers (T)");
-         s->magnetometer.hard_iron_t = Eigen::Vector3d(v[0], v[1], v[2]);
-       },
-       "a list of 3 finite numbers (tesla)"},
-      {"mag_soft_iron",
-       [](const YAML::Node& node, PipelineSettings* s) {
-         const auto v = node.as<std::vector<double>>();
-         if (v.size() != 9) throw YAML::Exception(node.Mark(), "needs 9 numbers (row-major 3x3)");
-         for (int i = 0; i < 9; ++i) s->magnetometer.soft_iron(i / 3, i % 3) = v[i];
-       },
-       "a list of 9 finite numbers, an invertible row-major 3x3 matrix"},
-      number<double>(
-          "mag_max_norm_change", [](auto* s) { return &s->disturbance.max_norm_change; },
-          kPositive),
-      number<double>(
-          "mag_max_dip_change_deg", [](auto* s) { return &s->disturbance.max_dip_change_deg; },
-          kPositive),
-      number<double>(
-          "mag_max_scatter_deg", [](auto* s) { return &s->disturbance.max_within_segment_std_deg; },
-          kPositive),
+      number<double>("mag_scale", CIA_MEMBER(magnetometer.scale), positive, "T per unit",
+                     "raw value x scale = tesla"),
+      numberList<3>(
+          "mag_hard_iron_t",
+          [](const PipelineSettings& s) {
+            const Eigen::Vector3d& v = s.magnetometer.hard_iron_t;
+            return std::vector<double>{v.x(), v.y(), v.z()};
+          },
+          [](const std::vector<double>& v, PipelineSettings* s) {
+            s->magnetometer.hard_iron_t = Eigen::Vector3d(v[0], v[1], v[2]);
+          },
+          [](const PipelineSettings& s) { return s.magnetometer.hard_iron_t.allFinite(); },
+          "a list of 3 finite numbers (tesla)", "T", "subtracted after scaling (IMU frame)"),
+      numberList<9>(
+          "mag_soft_iron",
+          [](const PipelineSettings& s) {
+            std::vector<double> v;
+            for (int i = 0; i < 9; ++i) v.push_back(s.magnetometer.soft_iron(i / 3, i % 3));
+            return v;
+          },
+          [](const std::vector<double>& v, PipelineSettings* s) {
+            for (int i = 0; i < 9; ++i) s->magnetometer.soft_iron(i / 3, i % 3) = v[i];
+          },
+          [](const PipelineSettings& s) {
+            return s.magnetometer.soft_iron.allFinite() &&
+                   std::abs(s.magnetometer.soft_iron.determinant()) >= 1e-6;
+          },
+          "a list of 9 finite numbers, an invertible row-major 3x3 matrix", "",
+          "soft-iron matrix, applied last"),
+      number<double>("mag_max_norm_change", CIA_MEMBER(disturbance.max_norm_change), positive, "",
+                     "relative |B| change against the undisturbed reference"),
+      number<double>("mag_max_dip_change_deg", CIA_MEMBER(disturbance.max_dip_change_deg), positive,
+                     "deg", "dip angle change against the reference"),
+      number<double>("mag_max_scatter_deg", CIA_MEMBER(disturbance.max_within_segment_std_deg),
+                     positive, "deg", "field direction scatter within a rest"),
       // Camera.
-      number<int>(
-          "min_target_points", [](auto* s) { return &s->detector.min_points; }, "an integer >= 4"),
-      number<double>(
-          "max_reprojection_rms_px", [](auto* s) { return &s->pose.max_reprojection_rms_px; },
-          kPositive),
-      number<double>(
-          "min_ambiguity_ratio", [](auto* s) { return &s->pose.min_ambiguity_ratio; }, kPositive),
-      number<int>(
-          "min_frames_per_pose", [](auto* s) { return &s->min_frames_per_pose; },
-          "an integer within [1, max_frames_per_pose]"),
-      number<int>(
-          "max_frames_per_pose", [](auto* s) { return &s->max_frames_per_pose; },
-          "an integer >= min_frames_per_pose"),
-      number<double>(
-          "min_frame_interval_s", [](auto* s) { return &s->min_frame_interval_s; }, kNonNegative),
-      number<double>(
-          "missed_frame_interval_s", [](auto* s) { return &s->missed_frame_interval_s; },
-          "a finite number >= min_frame_interval_s"),
-      number<double>(
-          "frame_margin_s", [](auto* s) { return &s->frame_margin_s; }, kNonNegative),
-      number<double>(
-          "max_camera_spread_deg", [](auto* s) { return &s->max_camera_spread_deg; }, kPositive),
-      number<double>(
-          "frame_queue_s", [](auto* s) { return &s->frame_queue_s; }, kPositive),
+      number<int>("min_target_points", CIA_MEMBER(detector.min_points), atLeast(4), "",
+                  "fewer detected points: frame not used"),
+      number<double>("max_reprojection_rms_px", CIA_MEMBER(pose.max_reprojection_rms_px), positive,
+                     "px", "PnP solutions above are rejected"),
+      number<double>("min_ambiguity_ratio", CIA_MEMBER(pose.min_ambiguity_ratio), positive, "",
+                     "planar PnP: second solution must be this much worse"),
+      number<int>("min_frames_per_pose", CIA_MEMBER(min_frames_per_pose), atLeast(1), "",
+                  "frames with a camera pose needed per rest"),
+      number<int>("max_frames_per_pose", CIA_MEMBER(max_frames_per_pose), atLeast(1), "",
+                  "detection stops after this many per rest"),
+      number<double>("min_frame_interval_s", CIA_MEMBER(min_frame_interval_s), non_negative, "s",
+                     "frames closer than this to the last detection are skipped"),
+      number<double>("missed_frame_interval_s", CIA_MEMBER(missed_frame_interval_s), non_negative,
+                     "s", "after 3 failed detections in a row: the interval between attempts"),
+      number<double>("frame_margin_s", CIA_MEMBER(frame_margin_s), non_negative, "s",
+                     "frames this close to a rest's ends are not used"),
+      number<double>("max_camera_spread_deg", CIA_MEMBER(max_camera_spread_deg), positive, "deg",
+                     "camera orientation scatter within a rest"),
+      number<double>("frame_queue_s", CIA_MEMBER(frame_queue_s), positive, "s",
+                     "frames wait at most this long for the IMU to judge them"),
       // Window and solver.
-      number<std::size_t>(
-          "window_poses", [](auto* s) { return &s->window_poses; }, "an integer within [2, 200]"),
-      number<int>(
-          "min_poses_to_solve", [](auto* s) { return &s->min_poses_to_solve; },
-          "an integer within [2, window_poses]"),
-      {"solver_method",
-       [](const YAML::Node& node, PipelineSettings* s) {
-         if (!parseSolverMethod(node.as<std::string>(), &s->solver.method)) {
-           throw YAML::Exception(node.Mark(), "unknown method");
-         }
-       },
-       "'optimal' or 'two_step'"},
-      number<int>(
-          "two_step_max_iterations", [](auto* s) { return &s->solver.two_step.max_iterations; },
-          "an integer >= 1"),
+      number<std::size_t>("window_poses", CIA_MEMBER(window_poses), within(2, 200), "",
+                          "sliding window of stationary poses"),
+      number<int>("min_poses_to_solve", CIA_MEMBER(min_poses_to_solve), atLeast(2), "",
+                  "poses in the window before a solve"),
+      wordKey<PipelineSettings>(
+          "solver_method", CIA_MEMBER(solver.method), {"optimal", "two_step"}, parseSolverMethod,
+          [](SolverMethod v) { return toString(v); }, "the pair solver"),
+      number<int>("two_step_max_iterations", CIA_MEMBER(solver.two_step.max_iterations), atLeast(1),
+                  "", "limit of the two-step when run alone"),
   };
   return table;
 }
+
+#undef CIA_MEMBER
 
 }  // namespace
 
@@ -189,25 +206,20 @@ const std::vector<std::string>& pipelineConfigKeys() {
   return names;
 }
 
+std::string PipelineSettings::validate() const {
+  const std::optional<SettingProblem> problem = findProblem(*this);
+  return problem ? problem->message : "";
+}
+
 void readPipelineKey(const std::string& source, const std::string& name, const YAML::Node& value,
                      PipelineSettings* settings) {
   const Key* key = findKey(keys(), name);
-  if (!key) throw InputError(source + ": unknown key '" + name + "' (see config/default.yaml)");
-  try {
-    key->read(value, settings);
-  } catch (const YAML::Exception&) {
-    throw InputError(badValueMessage(source, name, yamlText(value), key->allowed));
-  }
+  if (!key) throw SettingsError(source, name, unknownKeyMessage(name, pipelineConfigKeys()));
+  readKey(*key, source, value, settings);
 }
 
 void checkPipelineSettings(const std::string& source, const PipelineSettings& settings) {
-  if (settings.solver.two_step.max_iterations < 1) {
-    throw InputError(badValueMessage(source, "two_step_max_iterations",
-                                     std::to_string(settings.solver.two_step.max_iterations),
-                                     "an integer >= 1"));
-  }
-  const std::string error = settings.validate();
-  if (!error.empty()) throw InputError(source + ": " + error);
+  throwIfProblem(source, findProblem(settings));
 }
 
 YAML::Node parseSettingsYaml(const std::string& text, const std::string& source) {

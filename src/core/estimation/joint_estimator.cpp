@@ -177,13 +177,13 @@ JointResult solveModel(const JointProblem& problem, const Eigen::Matrix3d& R_cam
   }
   result.suggested_rotation_axis_imu = observability.suggested_rotation_axis_imu;
   result.notes = observability.notes;
-  if (!(result.std_dev_deg.maxCoeff() <= settings.max_std_dev_deg)) {
+  if (!(result.std_dev_deg.maxCoeff() <= settings.undetermined_std_dev_deg)) {
     char buffer[256];
     std::snprintf(buffer, sizeof(buffer),
                   "R_cam_imu is not determined: 1-sigma [%.2f %.2f %.2f] deg > %.2f deg (the "
                   "poses barely rotate)",
                   result.std_dev_deg(0), result.std_dev_deg(1), result.std_dev_deg(2),
-                  settings.max_std_dev_deg);
+                  settings.undetermined_std_dev_deg);
     result.message = buffer;
     return finish(result);
   }

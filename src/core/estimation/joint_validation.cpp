@@ -41,7 +41,8 @@ std::string validateSettings(const JointSettings& s) {
   }
   if (!finitePositive(s.gravity_m_s2)) return "settings: gravity_m_s2 must be finite and > 0";
   if (!finitePositive(s.robust_loss_scale)) return "settings: robust_loss_scale must be > 0";
-  if (!finitePositive(s.max_std_dev_deg)) return "settings: max_std_dev_deg must be > 0";
+  if (!finitePositive(s.undetermined_std_dev_deg))
+    return "settings: undetermined_std_dev_deg must be > 0";
   if (!(s.model_selection_level > 0.0 && s.model_selection_level < 1.0)) {
     return "settings: model_selection_level must be within (0, 1)";
   }

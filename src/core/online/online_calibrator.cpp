@@ -7,6 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "camera_imu_alignment/config/online_config.h"
+#include "camera_imu_alignment/config/settings_checks.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/solver/solution_quality.h"
 #include "solve_worker.h"
@@ -27,29 +29,6 @@ const char* toString(CalibrationState state) {
       return "recalibrating";
   }
   return "?";
-}
-
-std::string OnlineSettings::validate() const {
-  std::ostringstream out;
-  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
-  if (min_poses < 2) {
-    out << "min_poses = " << min_poses << ": must be an integer >= 2";
-  } else if (!positive(max_std_dev_deg)) {
-    out << "max_std_dev_deg = " << max_std_dev_deg << ": must be a finite number > 0";
-  } else if (!(consistency_level > 0.0 && consistency_level < 1.0)) {
-    out << "consistency_level = " << consistency_level << ": must be a number within (0, 1)";
-  } else if (!positive(max_residual_deg)) {
-    out << "max_residual_deg = " << max_residual_deg << ": must be a finite number > 0";
-  } else if (!(std::isfinite(min_change_deg) && min_change_deg >= 0.0)) {
-    out << "min_change_deg = " << min_change_deg << ": must be a finite number >= 0";
-  } else if (remount_poses < 1) {
-    out << "remount_poses = " << remount_poses << ": must be an integer >= 1";
-  } else if (!positive(remount_residual_deg)) {
-    out << "remount_residual_deg = " << remount_residual_deg << ": must be a finite number > 0";
-  } else {
-    return remount.validate();
-  }
-  return out.str();
 }
 
 struct OnlineCalibrator::Impl {
@@ -116,8 +95,7 @@ OnlineCalibrator::Impl::Impl(const TargetDescription& target,
                              const PipelineSettings& pipeline_settings_in,
                              const OnlineSettings& online, OnlineCallbacks cb)
     : pipeline_settings(pipeline_settings_in), settings(online), callbacks(std::move(cb)) {
-  const std::string error = settings.validate();
-  if (!error.empty()) throw std::invalid_argument(error);
+  throwIfProblem("", findProblem(pipeline_settings, settings));
   PipelineCallbacks pc;
   pc.on_pose = [this](const StationaryPose& p) { onPose(p); };
   pc.on_pose_rejected = [this](const RejectedPose& r) { onPoseRejected(r); };

@@ -11,8 +11,8 @@ SolveOutput runSolveJob(SolveJob job, const PipelineSettings& pipeline,
   out.generation = job.generation;
   out.result = solveWindow(job.window, pipeline);
   if (job.test_mount_change && out.result.joint && out.result.joint->ok) {
-    out.mount_test =
-        testMountChange(job.window.joint, *out.result.joint, pipeline.joint, online.remount);
+    out.mount_test = testMountChange(job.window.joint, *out.result.joint, jointSettingsOf(pipeline),
+                                     online.remount);
   }
   out.window = std::move(job.window);
   return out;

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "calibration_pipeline_impl.h"
+#include "camera_imu_alignment/config/settings_checks.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {
@@ -59,95 +60,17 @@ bool parseImuOrientationSource(const std::string& text, ImuOrientationSource* so
   return true;
 }
 
-namespace {
-
-std::string positive(const char* name, double value) {
-  if (std::isfinite(value) && value > 0.0) return "";
-  std::ostringstream out;
-  out << name << " = " << value << ": must be a finite number > 0";
-  return out.str();
+JointSettings jointSettingsOf(const PipelineSettings& settings) {
+  JointSettings joint = settings.joint;
+  joint.gravity_m_s2 = settings.stationary.gravity_m_s2;
+  return joint;
 }
+
+namespace {
 
 bool finite(const Eigen::Vector3d& v) { return v.allFinite(); }
 
 }  // namespace
-
-std::string PipelineSettings::validate() const {
-  const std::pair<const char*, double> positives[] = {
-      {"stationary_window_s", stationary.window_s},
-      {"min_stationary_duration_s", stationary.min_duration_s},
-      {"max_gyro_std_rad_s", stationary.max_gyro_std_rad_s},
-      {"max_accel_std_m_s2", stationary.max_accel_std_m_s2},
-      {"max_gyro_change_rad_s", stationary.max_gyro_change_rad_s},
-      {"max_gravity_turn_rate_rad_s", stationary.max_gravity_turn_rate_rad_s},
-      {"max_gyro_bias_rad_s", stationary.max_gyro_bias_rad_s},
-      {"max_rate_about_gravity_rad_s", stationary.max_rate_about_gravity_rad_s},
-      {"max_gravity_error_m_s2", stationary.max_gravity_error_m_s2},
-      {"gravity_m_s2", stationary.gravity_m_s2},
-      {"max_imu_gap_s", stationary.max_gap_s},
-      {"max_reprojection_rms_px", pose.max_reprojection_rms_px},
-      {"min_ambiguity_ratio", pose.min_ambiguity_ratio},
-      {"max_camera_spread_deg", max_camera_spread_deg},
-      {"max_gyro_span_s", max_gyro_span_s},
-      {"frame_queue_s", frame_queue_s},
-      {"mag_scale", magnetometer.scale},
-  };
-  for (const auto& [name, value] : positives) {
-    const std::string error = positive(name, value);
-    if (!error.empty()) return error;
-  }
-  const std::pair<const char*, double> more_positives[] = {
-      {"mag_max_norm_change", disturbance.max_norm_change},
-      {"mag_max_dip_change_deg", disturbance.max_dip_change_deg},
-      {"mag_max_scatter_deg", disturbance.max_within_segment_std_deg},
-      {"imu_prior_gyro_scale", joint.priors.gyro_scale},
-      {"imu_prior_gyro_cross_axis", joint.priors.gyro_cross_axis},
-      {"imu_prior_gyro_bias_walk_rad_s_sqrt_s", joint.priors.gyro_bias_walk_rad_s_sqrt_s},
-      {"imu_prior_accel_scale", joint.priors.accel_scale},
-      {"imu_prior_accel_cross_axis", joint.priors.accel_cross_axis},
-      {"imu_prior_accel_bias_m_s2", joint.priors.accel_bias_m_s2},
-      {"imu_prior_accel_bias_walk_m_s2_sqrt_s", joint.priors.accel_bias_walk_m_s2_sqrt_s},
-      {"imu_prior_soft_iron_scale", joint.priors.soft_iron_scale},
-      {"imu_prior_soft_iron_cross", joint.priors.soft_iron_cross},
-      {"imu_prior_hard_iron_t", joint.priors.hard_iron_t},
-  };
-  for (const auto& [name, value] : more_positives) {
-    const std::string error = positive(name, value);
-    if (!error.empty()) return error;
-  }
-  std::ostringstream out;
-  if (detector.min_points < 4) {
-    out << "min_target_points = " << detector.min_points << ": must be >= 4";
-  } else if (!(stationary.noise_factor >= 0.0 && std::isfinite(stationary.noise_factor))) {
-    out << "stationary_noise_factor = " << stationary.noise_factor << ": must be >= 0";
-  } else if (!(stationary.change_noise_factor >= 0.0 &&
-               std::isfinite(stationary.change_noise_factor))) {
-    out << "stationary_change_noise_factor = " << stationary.change_noise_factor
-        << ": must be >= 0";
-  } else if (!(frame_margin_s >= 0.0 && std::isfinite(frame_margin_s))) {
-    out << "frame_margin_s = " << frame_margin_s << ": must be >= 0";
-  } else if (!(min_frame_interval_s >= 0.0 && std::isfinite(min_frame_interval_s))) {
-    out << "min_frame_interval_s = " << min_frame_interval_s << ": must be >= 0";
-  } else if (!(missed_frame_interval_s >= min_frame_interval_s &&
-               std::isfinite(missed_frame_interval_s))) {
-    out << "missed_frame_interval_s = " << missed_frame_interval_s
-        << ": must be finite and >= min_frame_interval_s";
-  } else if (window_poses < 2 || window_poses > 200) {
-    out << "window_poses = " << window_poses << ": must be within [2, 200]";
-  } else if (min_poses_to_solve < 2 ||
-             static_cast<std::size_t>(min_poses_to_solve) > window_poses) {
-    out << "min_poses_to_solve = " << min_poses_to_solve << ": must be within [2, window_poses]";
-  } else if (min_frames_per_pose < 1 || max_frames_per_pose < min_frames_per_pose) {
-    out << "min_frames_per_pose = " << min_frames_per_pose
-        << ", max_frames_per_pose = " << max_frames_per_pose << ": need 1 <= min <= max";
-  } else if (!(accel_weight > 0.0 && accel_weight < 1.0)) {
-    out << "accel_weight = " << accel_weight << ": must be within (0, 1)";
-  } else if (!magnetometer.hard_iron_t.allFinite() || !magnetometer.soft_iron.allFinite() ||
-             std::abs(magnetometer.soft_iron.determinant()) < 1e-6) {
-    out << "mag_hard_iron_t / mag_soft_iron: must be finite, mag_soft_iron invertible";
-  }
-  return out.str();
-}
 
 CalibrationPipeline::Impl::Impl(const TargetDescription& target_, const PipelineSettings& settings_,
                                 PipelineCallbacks callbacks_)
@@ -174,8 +97,7 @@ void CalibrationPipeline::rejectInput(RejectReason reason, InputStream stream,
 CalibrationPipeline::CalibrationPipeline(const TargetDescription& target,
                                          const PipelineSettings& settings,
                                          PipelineCallbacks callbacks) {
-  const std::string error = settings.validate();
-  if (!error.empty()) throw std::invalid_argument(error);
+  throwIfProblem("", findProblem(settings));
   impl_ = std::make_unique<Impl>(target, settings, std::move(callbacks));
 }
 

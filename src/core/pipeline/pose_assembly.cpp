@@ -352,7 +352,8 @@ AlignmentResult solveWindow(const WindowSnapshot& window, const PipelineSettings
     return result;
   }
   // The joint estimate, started from the pair solve.
-  const JointResult joint = JointEstimator(settings.joint).solve(window.joint, result.R_cam_imu);
+  const JointResult joint =
+      JointEstimator(jointSettingsOf(settings)).solve(window.joint, result.R_cam_imu);
   const std::string sensors = settings.imu_orientation == ImuOrientationSource::kMagnetometer
                                   ? " (camera, accelerometer, magnetometer; gyro not used)"
                                   : "";
