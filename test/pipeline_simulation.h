@@ -53,7 +53,6 @@ struct CalibratorRun {
   std::shared_ptr<std::vector<EstimateEvent>> estimates;
   Injected injected;
   Eigen::Matrix3d R_cam_imu_true() const { return run->trajectory.R_cam_imu_final(); }
-  const CalibrationPipeline& pipeline() const { return calibrator->pipeline(); }
 };
 
 inline CameraIntrinsics simulatedIntrinsics(const simulation::SimulationConfig& c) {

@@ -139,5 +139,29 @@ TEST(BroadcastGate, ChangesBelowTheThresholdKeepTheTf) {
             GateDecision::kBroadcast);
 }
 
+// The check of a current calibration: the difference in degrees and in sigmas under both
+// covariances (analytic: 0.1 deg about z with 1-sigma 0.03 deg on each side is 0.1 / sqrt(2 *
+// 0.03^2) = 2.357 sigma, chi2 5.56 on 3 dof, p 0.135).
+TEST(BroadcastGate, CheckOfACurrentCalibrationInDegreesAndSigmas) {
+  const AlignmentResult estimate = jointResult(0.03, turned(0.1), 0.5);
+  const BroadcastEstimate current = broadcastOf(jointResult(0.03, turned(0.0), 0.5), 12);
+  const auto check = checkCalibration(estimate, current, 1e-3);
+  ASSERT_TRUE(check);
+  EXPECT_NEAR(check->error_deg, 0.1, 1e-9);
+  EXPECT_NEAR(check->sigmas, 0.1 / std::sqrt(2.0 * 0.03 * 0.03), 1e-6);
+  EXPECT_NEAR(check->chi2, check->sigmas * check->sigmas, 1e-9);
+  EXPECT_NEAR(check->p_value, 0.1353, 1e-3);
+  EXPECT_TRUE(check->consistent);
+  EXPECT_FALSE(checkCalibration(estimate, current, 0.2)->consistent);
+  // A calibration 1 deg off is tens of sigma away.
+  const auto far = checkCalibration(jointResult(0.03, turned(1.0), 0.5), current, 1e-3);
+  ASSERT_TRUE(far);
+  EXPECT_FALSE(far->consistent);
+  EXPECT_GT(far->sigmas, 20.0);
+  EXPECT_NE(far->text.find("recalibrate"), std::string::npos) << far->text;
+  // No joint estimate (pair modes): no check.
+  EXPECT_FALSE(checkCalibration(goodResult(0.03), current, 1e-3));
+}
+
 }  // namespace
 }  // namespace camera_imu_alignment

@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
@@ -282,6 +283,41 @@ TEST(CalibrateBag, AMountThatMovedHalfwayExitsFourNamingThePose) {
   ASSERT_NE(at, std::string::npos) << result.run.out;
   const double error_deg = std::stod(result.run.out.substr(result.run.out.find(": ", at) + 2));
   EXPECT_LT(error_deg, 0.2) << result.run.out;
+  removeBag(bag);
+}
+
+// --check: the true calibration is still right (exit 0), one turned by 1 deg is not (exit 4), each
+// with its error in degrees and sigmas; nothing is written.
+TEST(CalibrateBag, CheckModeTellsWhetherTheCurrentCalibrationStillHolds) {
+  const std::string bag = simulate("check", "--scenario nominal --seed 36 --num-poses 8");
+  const std::string truth = stem(bag) + ".truth.yaml";
+  const Eigen::Matrix3d R_true = readResultYaml(truth).R_cam_imu;
+  const std::string turned = temp("turned.yaml");
+  {
+    const Eigen::Quaterniond q(expSO3(Eigen::Vector3d(0.0, 0.0, deg2rad(1.0))) * R_true);
+    std::ofstream out(turned);
+    out << "R_cam_imu:\n  quaternion_xyzw: [" << q.x() << ", " << q.y() << ", " << q.z() << ", "
+        << q.w() << "]\n";
+  }
+  const std::string output = temp("check_result.yaml");
+  std::filesystem::remove(output);
+  const std::string base = kCalibrate + " --quiet --bag " + bag + " --target " + stem(bag) +
+                           ".target.yaml --output " + output + " --check ";
+  const test::ToolRun right = test::runTool(base + truth);
+  EXPECT_EQ(right.exit_code, 0) << right.err << right.out;
+  EXPECT_NE(right.out.find("still right"), std::string::npos) << right.out;
+  const test::ToolRun wrong = test::runTool(base + turned);
+  EXPECT_EQ(wrong.exit_code, 4) << wrong.err << wrong.out;
+  EXPECT_NE(wrong.out.find("NOT consistent"), std::string::npos) << wrong.out;
+  // About 1 deg off, and many sigmas.
+  const std::size_t at = wrong.out.find("the current calibration is ");
+  ASSERT_NE(at, std::string::npos);
+  const double error_deg = std::stod(wrong.out.substr(at + 27));
+  EXPECT_NEAR(error_deg, 1.0, 0.15) << wrong.out;
+  EXPECT_FALSE(std::filesystem::exists(output));
+  const test::ToolRun missing = test::runTool(base + temp("no_such.yaml"));
+  EXPECT_EQ(missing.exit_code, 2) << missing.err;
+  EXPECT_NE(missing.err.find("--check"), std::string::npos) << missing.err;
   removeBag(bag);
 }
 

@@ -37,9 +37,8 @@ int trueHold(const sim::Trajectory& trajectory, double start_s, double end_s) {
 
 /// Checks the estimate from the final window: error below `max_error_deg` and within 3 sigma on
 /// every axis.
-void expectAccurate(const CalibrationPipeline& pipeline, const Eigen::Matrix3d& R_cam_imu_true,
+void expectAccurate(const AlignmentResult& result, const Eigen::Matrix3d& R_cam_imu_true,
                     double max_error_deg) {
-  const AlignmentResult result = test::solveFinalWindow(pipeline);
   ASSERT_EQ(result.status, SolveStatus::kOk) << result.message;
   const Eigen::Vector3d error = test::leftError(result.R_cam_imu, R_cam_imu_true);
   EXPECT_LT(rad2deg(error.norm()), max_error_deg);
@@ -49,13 +48,18 @@ void expectAccurate(const CalibrationPipeline& pipeline, const Eigen::Matrix3d& 
   }
 }
 
+void expectAccurate(const CalibrationPipeline& pipeline, const Eigen::Matrix3d& R_cam_imu_true,
+                    double max_error_deg) {
+  expectAccurate(test::solveFinalWindow(pipeline), R_cam_imu_true, max_error_deg);
+}
+
 TEST(CalibrationPipeline, NominalRunFindsEveryPoseAndTheMounting) {
   // Through the online calibrator (the product's path), solving on this thread.
   const auto r = test::runCalibrator(scenario("nominal", 3));
-  const CalibrationPipeline& pipeline = r.pipeline();
+  const CalibrationSnapshot snap = r.calibrator->snapshot();
   const auto& trajectory = r.run->trajectory;
-  const auto& poses = pipeline.poses();
-  EXPECT_EQ(poses.size(), trajectory.poses().size()) << pipeline.rejections().summary();
+  const auto& poses = snap.poses;
+  EXPECT_EQ(poses.size(), trajectory.poses().size()) << snap.rejections.summary();
   const Eigen::Matrix3d R_world_target = trajectory.R_world_target();
   std::vector<int> holds;
   for (const auto& pose : poses) {
@@ -84,15 +88,17 @@ TEST(CalibrationPipeline, NominalRunFindsEveryPoseAndTheMounting) {
     ASSERT_TRUE(poses[k].gyro_mag_difference_deg.has_value());
     EXPECT_LT(*poses[k].gyro_mag_difference_deg, 2.0);
   }
-  expectAccurate(pipeline, r.R_cam_imu_true(), 0.1);
+  ASSERT_TRUE(snap.latest);
+  EXPECT_EQ(snap.latest->window_poses, poses.size());  // the final window's estimate
+  expectAccurate(snap.latest->result, r.R_cam_imu_true(), 0.1);
   // Detection ran only at rest, on a bounded number of frames per rest.
-  EXPECT_LE(pipeline.framesDetected(),
-            pipeline.segments().size() * pipeline.settings().max_frames_per_pose);
-  EXPECT_LT(pipeline.framesDetected(), pipeline.frames() / 2);
-  EXPECT_EQ(pipeline.rejections().total(), 0u) << pipeline.rejections().summary();
+  EXPECT_LE(snap.inputs.frames_detected,
+            snap.rests.size() * PipelineSettings{}.max_frames_per_pose);
+  EXPECT_LT(snap.inputs.frames_detected, snap.inputs.frames / 2);
+  EXPECT_EQ(snap.rejections.total(), 0u) << snap.rejections.summary();
   // An estimate after every pose from the third on (min_poses_to_solve), no remount.
   EXPECT_EQ(r.estimates->size(), poses.size() - 2);
-  EXPECT_EQ(r.calibrator->remounts(), 0);
+  EXPECT_EQ(snap.remounts, 0);
 }
 
 std::unique_ptr<CalibrationPipeline> runWithoutImages(const sim::SimulationRun& run,
@@ -274,23 +280,23 @@ TEST(CalibrationPipeline, ATargetPartlyOrNotInViewIsCountedAndGivesNoPose) {
     settings.min_frame_interval_s = 0.15;
     settings.missed_frame_interval_s = 1.0;
     const auto r = test::runCalibrator(c, settings, injection);
-    const CalibrationPipeline& pipeline = r.pipeline();
-    EXPECT_EQ(pipeline.posesTotal(), 0u) << covered;
+    const CalibrationSnapshot snap = r.calibrator->snapshot();
+    EXPECT_EQ(snap.poses_total, 0u) << covered;
     // After 3 misses in a row at a rest, one attempt per missed_frame_interval_s (a miss costs
     // up to 15x a hit); at min_frame_interval_s a 4 s rest would cost about 25 attempts.
-    ASSERT_EQ(pipeline.segments().size(), 2u) << covered;
+    ASSERT_EQ(snap.rests.size(), 2u) << covered;
     double most_attempts = 0.0;
-    for (const StationarySegment& rest : pipeline.segments()) {
+    for (const StationarySegment& rest : snap.rests) {
       most_attempts += 3 + 1.0 + rest.duration() / 1.0;  // 3: kMissesBeforeBackoff
     }
-    EXPECT_GE(pipeline.framesDetected(), 2u * 3u) << covered;
-    EXPECT_LE(pipeline.framesDetected(), most_attempts) << covered;
+    EXPECT_GE(snap.inputs.frames_detected, 2u * 3u) << covered;
+    EXPECT_LE(snap.inputs.frames_detected, most_attempts) << covered;
     // Every detection attempt at rest failed and was counted; none was taken for a pose.
-    EXPECT_EQ(pipeline.rejections().count(RejectReason::kTargetNotFound), pipeline.framesDetected())
+    EXPECT_EQ(snap.rejections.count(RejectReason::kTargetNotFound), snap.inputs.frames_detected)
         << covered;
-    ASSERT_FALSE(pipeline.rejectedPoses().empty()) << covered;
-    EXPECT_NE(pipeline.rejectedPoses()[0].reason.find("target seen in 0"), std::string::npos)
-        << pipeline.rejectedPoses()[0].reason;
+    ASSERT_FALSE(snap.rejected_poses.empty()) << covered;
+    EXPECT_NE(snap.rejected_poses[0].reason.find("target seen in 0"), std::string::npos)
+        << snap.rejected_poses[0].reason;
     EXPECT_TRUE(r.estimates->empty()) << covered;
   }
 }

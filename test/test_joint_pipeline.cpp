@@ -297,7 +297,7 @@ TEST(JointPipeline, LocalGravityReachesTheJointEstimate) {
       settings.joint = jointSettingsFor(c);
       settings.stationary.gravity_m_s2 = g_setting;
       const auto pipeline = test::feedWithoutImages(run, settings, 0.03, false, 100 + c.seed);
-      const AlignmentResult r = pipeline->solve();
+      const AlignmentResult r = test::solveFinalWindow(*pipeline);
       ASSERT_TRUE(r.joint && r.joint->ok) << seed << ": " << r.message;
       ASSERT_TRUE(r.joint->intrinsics.accel_matrix_estimated) << seed;
       *error_deg = rad2deg(geodesicDistance(r.R_cam_imu, run.trajectory.R_cam_imu_final()));

@@ -121,16 +121,7 @@ void AlignmentWrapper::Impl::loadSaved() {
   if (!stored) return;
   saved_camera_frame = stored->camera_frame;
   saved_imu_frame = stored->imu_frame;
-  BroadcastEstimate loaded;
-  loaded.R_cam_imu = stored->R_cam_imu;
-  if (stored->std_dev_deg) {
-    loaded.std_dev_deg = *stored->std_dev_deg;
-    // Its covariance as far as the file tells (per-axis 1-sigma; the correlations are not saved).
-    const Eigen::Vector3d sigma_rad = *stored->std_dev_deg * (M_PI / 180.0);
-    loaded.covariance_rad2 = Eigen::Matrix3d(sigma_rad.cwiseProduct(sigma_rad).asDiagonal());
-  }
-  loaded.poses = stored->num_poses;
-  loaded.source = "loaded: " + settings.output_file;
+  const BroadcastEstimate loaded = storedBroadcast(*stored, "loaded: " + settings.output_file);
   calibrator->loadBroadcast(loaded);
   ROS_INFO("%s: calibration loaded from %s (%d poses, 1-sigma %s deg)", name.c_str(),
            settings.output_file.c_str(), loaded.poses,
@@ -175,6 +166,13 @@ void AlignmentWrapper::Impl::publishStatus() {
       s.dof = static_cast<std::uint32_t>(std::max(0, r.joint->dof));
       s.p_value = r.joint->chi2_p_value;
     }
+  }
+  s.poses_needed = snap.progress.poses_needed;
+  if (snap.check) {
+    s.has_check = true;
+    s.check_error_deg = snap.check->error_deg;
+    s.check_sigmas = snap.check->sigmas;
+    s.check_consistent = snap.check->consistent;
   }
   const Eigen::Vector3d axis = snap.progress.rotate_about_cam;
   s.rotate_about_cam.x = axis.x();

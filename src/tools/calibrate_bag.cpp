@@ -50,7 +50,8 @@ const char* kUsage =
     "                     [--camera-info-topic T] [--method optimal|two_step]\n"
     "                     [--imu-orientation joint|auto|magnetometer|message]\n"
     "                     [--output RESULT.yaml] [--imu-yaml IMU.yaml] [--report REPORT.png]\n"
-    "                     [--truth TRUTH.yaml] [--export-poses POSES.csv] [--quiet]\n"
+    "                     [--truth TRUTH.yaml] [--export-poses POSES.csv]\n"
+    "                     [--check CURRENT.yaml] [--quiet]\n"
     "  --bag FILE.bag        ROS 1 bag: sensor_msgs/Imu, optional MagneticField, Image or\n"
     "                        CompressedImage and CameraInfo (topics found by type when not given)\n"
     "  --target TARGET.yaml  Kalibr target file (checkerboard, aprilgrid, circlegrid)\n"
@@ -71,6 +72,10 @@ const char* kUsage =
     "                        error to\n"
     "  --export-poses POSES.csv  write the stationary poses the estimate used (the window) as the\n"
     "                        poses CSV that solve_rotation --poses reads (doc/CONVENTIONS.md)\n"
+    "  --check CURRENT.yaml  is the current calibration (a result YAML) still right? Its\n"
+    "                        difference to the bag's joint estimate in degrees and sigmas and the\n"
+    "                        chi-square test at consistency_level: exit 0 when consistent, 4 when\n"
+    "                        not (nothing is written to --output / --imu-yaml)\n"
     "  --quiet               no progress on stderr\n"
     "exit codes: 0 success, 2 bad input or usage, 3 not enough information (the message says what\n"
     "motion is missing), 4 an estimate that fails the quality gates or a mount that moved during\n"
@@ -134,6 +139,15 @@ int run(const cia::CliArgs& args) {
     std::cerr << "calibrate_bag: --imu-orientation " << args.get("--imu-orientation")
               << ": must be joint, auto, magnetometer or message\n";
     return kExitBadInput;
+  }
+  std::optional<cia::StoredCalibration> current;
+  if (args.has("--check")) {
+    try {
+      current = cia::readResultYaml(args.get("--check"));
+    } catch (const cia::InputError& e) {
+      std::cerr << "calibrate_bag: --check " << e.what() << "\n";
+      return kExitBadInput;
+    }
   }
   std::optional<cia::StoredCalibration> truth;
   if (args.has("--truth")) {
@@ -256,6 +270,19 @@ int run(const cia::CliArgs& args) {
     std::cerr << "calibrate_bag: " << report.result.message << "\n";
     return kExitNotEnoughInformation;  // the bag was read; it did not hold enough information
   }
+  if (current) {
+    const std::optional<cia::CalibrationCheck> check =
+        cia::checkCalibration(report.result, cia::storedBroadcast(*current, args.get("--check")),
+                              online.consistency_level);
+    if (!check) {
+      std::cerr << "calibrate_bag: --check needs the joint estimate (--imu-orientation joint or "
+                   "magnetometer) with its covariance; "
+                << (report.result.joint ? report.result.joint->message : "none was run") << "\n";
+      return kExitNotEnoughInformation;
+    }
+    std::cout << "check: " << args.get("--check") << ": " << check->text << "\n";
+    return check->consistent ? kExitOk : kExitQualityGate;  // a check writes no result
+  }
   if (!gates_passed) {
     std::cerr << "calibrate_bag: the estimate fails the quality gates (see 'verdict:'); not "
                  "written to --output / --imu-yaml\n";
@@ -282,11 +309,12 @@ int run(const cia::CliArgs& args) {
 int main(int argc, char** argv) {
   cia::CliArgs args = [&] {
     try {
-      return cia::CliArgs(argc, argv,
-                          {"--bag", "--target", "--config", "--imu-topic", "--mag-topic",
-                           "--image-topic", "--camera-info-topic", "--method", "--imu-orientation",
-                           "--output", "--imu-yaml", "--report", "--truth", "--export-poses"},
-                          {"--help", "--quiet"});
+      return cia::CliArgs(
+          argc, argv,
+          {"--bag", "--target", "--config", "--imu-topic", "--mag-topic", "--image-topic",
+           "--camera-info-topic", "--method", "--imu-orientation", "--output", "--imu-yaml",
+           "--report", "--truth", "--export-poses", "--check"},
+          {"--help", "--quiet"});
     } catch (const cia::UsageError& e) {
       std::cerr << "calibrate_bag: " << e.what() << "\n" << kUsage;
       std::exit(kExitBadInput);

@@ -55,4 +55,23 @@ GateOutcome judgeEstimate(const AlignmentResult& result, std::size_t window_pose
 /// their summed covariances; 1 when the broadcast one has no covariance.
 double differenceSignificance(const AlignmentResult& result, const BroadcastEstimate& broadcast);
 
+/// "Is my current calibration still right?": a new estimate against a current (broadcast or
+/// saved) calibration.
+struct CalibrationCheck {
+  double error_deg = 0;  ///< angle between the two rotations
+  /// Mahalanobis length of the difference, sqrt(chi2), under the new estimate's covariance plus
+  /// the current calibration's (when it has one: a saved 1-sigma counts as independent per axis).
+  double sigmas = 0;
+  double chi2 = 0;         ///< 3 dof
+  double p_value = 1;      ///< chi-square upper tail
+  bool consistent = true;  ///< p_value >= consistency_level
+  std::string text;        ///< one line with the figures and the verdict
+};
+
+/// The check of `current` by `estimate` (a solved joint estimate with its covariance; nullopt
+/// otherwise) at `consistency_level`.
+std::optional<CalibrationCheck> checkCalibration(const AlignmentResult& estimate,
+                                                 const BroadcastEstimate& current,
+                                                 double consistency_level);
+
 }  // namespace camera_imu_alignment

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "camera_imu_alignment/inertial/stationary_detector.h"
+#include "camera_imu_alignment/io/result_yaml.h"
 #include "camera_imu_alignment/online/broadcast_gate.h"
 #include "camera_imu_alignment/online/online_types.h"
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
@@ -66,6 +67,10 @@ struct CalibrationProgress {
   std::string imu_guidance;
 };
 
+/// A saved calibration (a result YAML) as a broadcast estimate: its per-axis 1-sigma as a diagonal
+/// covariance (the correlations are not saved), infinite 1-sigma when the file has none.
+BroadcastEstimate storedBroadcast(const StoredCalibration& stored, const std::string& source);
+
 /// "IMU parameters held at their priors: ...; to calibrate them, rotate about the camera axis
 /// (x, y, z)" for a joint estimate that holds some ("" otherwise).
 std::string imuGuidanceOf(const EstimateEvent& estimate);
@@ -109,6 +114,8 @@ struct CalibrationSnapshot {
   std::optional<BroadcastEstimate> broadcast;  ///< what the static tf says
   std::optional<CalibrationVerdict> verdict;   ///< of the latest estimate (recordingVerdict)
   std::vector<RemountEvent> remount_events;    ///< since the start or the last reset (newest 100)
+  /// The latest estimate against the broadcast one (when both exist): is the tf still right?
+  std::optional<CalibrationCheck> check;
   int remounts = 0;
   CalibrationProgress progress;
 

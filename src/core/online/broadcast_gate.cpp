@@ -32,6 +32,34 @@ double differenceSignificance(const AlignmentResult& result, const BroadcastEsti
   return boost::math::cdf(boost::math::complement(boost::math::chi_squared(3.0), chi2));
 }
 
+std::optional<CalibrationCheck> checkCalibration(const AlignmentResult& estimate,
+                                                 const BroadcastEstimate& current,
+                                                 double consistency_level) {
+  if (estimate.status != SolveStatus::kOk || !estimate.joint || !estimate.joint->ok) {
+    return std::nullopt;
+  }
+  Eigen::Matrix3d covariance = estimate.joint->covariance_rad2;
+  if (current.covariance_rad2) covariance += *current.covariance_rad2;
+  if (!covariance.allFinite() || !(covariance.determinant() > 0.0)) return std::nullopt;
+  CalibrationCheck check;
+  const Eigen::Vector3d difference = logSO3(estimate.R_cam_imu * current.R_cam_imu.transpose());
+  check.error_deg = rad2deg(difference.norm());
+  check.chi2 = difference.dot(covariance.inverse() * difference);
+  if (!std::isfinite(check.chi2)) return std::nullopt;
+  check.sigmas = std::sqrt(check.chi2);
+  check.p_value =
+      boost::math::cdf(boost::math::complement(boost::math::chi_squared(3.0), check.chi2));
+  check.consistent = check.p_value >= consistency_level;
+  std::ostringstream text;
+  text.precision(3);
+  text << "the current calibration is " << check.error_deg << " deg (" << check.sigmas
+       << " sigma) from the new estimate: chi2 " << check.chi2 << " (3 dof), p " << check.p_value
+       << (check.consistent ? " >= " : " < ") << "consistency_level " << consistency_level << ": "
+       << (check.consistent ? "still right" : "NOT consistent with the new poses: recalibrate");
+  check.text = text.str();
+  return check;
+}
+
 GateOutcome judgeEstimate(const AlignmentResult& r, std::size_t window_poses,
                           const OnlineSettings& settings,
                           const std::optional<BroadcastEstimate>& broadcast, bool fresh_start) {

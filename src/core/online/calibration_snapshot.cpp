@@ -28,6 +28,19 @@ std::optional<CalibrationVerdict> recordingVerdict(const EstimateEvent& estimate
   return verdict;
 }
 
+BroadcastEstimate storedBroadcast(const StoredCalibration& stored, const std::string& source) {
+  BroadcastEstimate loaded;
+  loaded.R_cam_imu = stored.R_cam_imu;
+  if (stored.std_dev_deg) {
+    loaded.std_dev_deg = *stored.std_dev_deg;
+    const Eigen::Vector3d sigma_rad = *stored.std_dev_deg * (M_PI / 180.0);
+    loaded.covariance_rad2 = Eigen::Matrix3d(sigma_rad.cwiseProduct(sigma_rad).asDiagonal());
+  }
+  loaded.poses = stored.num_poses;
+  loaded.source = source;
+  return loaded;
+}
+
 std::string imuGuidanceOf(const EstimateEvent& estimate) {
   if (!estimate.result.joint || !estimate.result.joint->ok) return "";
   const JointResult& joint = *estimate.result.joint;

@@ -469,6 +469,9 @@ CalibrationSnapshot OnlineCalibrator::snapshot() const {
                                                 c.last_estimate->result.R_cam_imu)) <= 1e-9;
   if (c.last_estimate) s.verdict = recordingVerdict(*c.last_estimate, c.remount_events);
   s.remount_events = c.remount_events;
+  if (c.last_estimate && c.broadcast) {
+    s.check = checkCalibration(c.last_estimate->result, *c.broadcast, c.settings.consistency_level);
+  }
   s.remounts = c.remounts;
   s.progress = progressOf(c.last_estimate, c.settings.max_std_dev_deg);
   return s;
