@@ -5,8 +5,9 @@ Usage: count_test_results.py RESULTS_DIR CTEST_EXIT_CODE CTEST_LOG [CHECKS_FILE]
 A test executable that ctest reports as failed but whose XML shows no failing case (it crashed or
 timed out before writing its results) counts as one failure. CHECKS_FILE (from scripts/lint) holds
 one "<check> passed|failed" line per further check, each counted as one test; given but missing,
-unreadable or empty, it counts as one failure. Skipped cases are reported on the line before the
-last. The last line is exactly "N passed, N failed". Exits 1 on any failure or on no tests.
+unreadable or empty, it counts as one failure. Then each test executable's wall time as ctest
+printed it, slowest first, and the skipped cases on the line before the last. The last line is
+exactly "N passed, N failed". Exits 1 on any failure or on no tests.
 """
 import os
 import re
@@ -57,10 +58,26 @@ def main():
         check_passed, check_failed = count_checks(sys.argv[4])
         passed += check_passed
         failed += check_failed
+    print_wall_times(ctest_log)
     if skipped:
         print(f"{skipped} skipped")
     print(f"{passed} passed, {failed} failed")
     return 1 if failed or passed == 0 else 0
+
+
+def print_wall_times(ctest_log):
+    """The wall time of every test ctest ran (its "Test #N: name ... sec" lines), slowest first."""
+    try:
+        with open(ctest_log, encoding="utf-8", errors="replace") as log:
+            times = re.findall(r"Test +#\d+: (\S+) \.*[^\n]*? ([0-9.]+) sec", log.read())
+    except OSError:
+        return
+    if not times:
+        return
+    total = sum(float(seconds) for _, seconds in times)
+    print(f"wall time per test, slowest first ({len(times)} tests, {total:.0f} s in all):")
+    for name, seconds in sorted(times, key=lambda t: -float(t[1])):
+        print(f"  {float(seconds):8.1f} s  {name.replace('_ctest_camera_imu_alignment_', '')}")
 
 
 def count_checks(path):

@@ -45,16 +45,12 @@ namespace {
 
 const std::string kNode = "/camera_imu_alignment";
 
-std::string temp(const std::string& name) { return test::processTempDir() + name; }
+std::string temp(const std::string& name) { return test::tempPath(name); }
 
 /// Simulates a bag (5 Hz camera) and checks that its target is the one the node was started with.
 std::string simulate(const std::string& name, const std::string& options) {
-  const std::string bag = temp(name + ".bag");
-  const test::ToolRun r = test::runTool(std::string(SIMULATE_BAG_EXE) + " --out " + bag +
-                                        " --camera-rate-hz 5 " + options);
-  EXPECT_EQ(r.exit_code, 0) << r.err;
-  const std::string stem = bag.substr(0, bag.size() - 4);
-  EXPECT_EQ(test::readTextFile(stem + ".target.yaml"), test::readTextFile(TARGET_YAML))
+  const std::string bag = test::simulateBag(SIMULATE_BAG_EXE, name, options);
+  EXPECT_EQ(test::readFile(test::bagStem(bag) + ".target.yaml"), test::readFile(TARGET_YAML))
       << "the simulator's target changed: update test/data/sim_checkerboard_8x6.yaml";
   return bag;
 }
@@ -83,10 +79,6 @@ std::optional<Eigen::Matrix3d> waitForTf(
     ros::WallDuration(0.2).sleep();
   }
   return last;
-}
-
-double angleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
-  return rad2deg(rotationAngle(a.transpose() * b));
 }
 
 Eigen::Matrix3d toMatrix(const geometry_msgs::Quaternion& q) {
@@ -213,8 +205,8 @@ class ExtraNode {
     return std::system((cmd + " 2>/dev/null").c_str()) == 0;
   }
   std::string log() const {
-    std::string out = test::readTextFile(path("log"));
-    if (g_instance_kind == "nodelet") out += test::readTextFile(path("loader.log"));
+    std::string out = test::readFile(path("log"));
+    if (g_instance_kind == "nodelet") out += test::readFile(path("loader.log"));
     return out;
   }
 
@@ -261,7 +253,7 @@ TEST_F(AlignmentRos, ReplayBroadcastsTheTruthAndTheServicesWork) {
   auto player = play(bag, 3.0);
   const auto R = waitForTf(buffer_, "camera_optical_frame", "imu_link", 180.0);
   ASSERT_TRUE(R) << "no tf camera_optical_frame -> imu_link";
-  EXPECT_LT(angleDeg(*R, R_true), 0.2);
+  EXPECT_LT(test::angleBetweenDeg(*R, R_true), 0.2);
   EXPECT_EQ(player.get(), 0);
 
   // The last rest is closed 2 s (wall) after the IMU stops: then all 7 poses are in.
@@ -289,7 +281,7 @@ TEST_F(AlignmentRos, ReplayBroadcastsTheTruthAndTheServicesWork) {
   ASSERT_TRUE(call("calibrate", &forced));
   EXPECT_TRUE(forced.response.broadcast) << forced.response.not_broadcast_reason;
   EXPECT_TRUE(calibrate.response.observable);
-  EXPECT_LT(angleDeg(toMatrix(calibrate.response.q_cam_imu), R_true), 0.2);
+  EXPECT_LT(test::angleBetweenDeg(toMatrix(calibrate.response.q_cam_imu), R_true), 0.2);
   EXPECT_GT(calibrate.response.std_dev_deg[0], 0.0);
   // calibrate_bag drives the same pipeline: the same poses, the same answer.
   const std::string offline = temp("offline.yaml");
@@ -297,7 +289,8 @@ TEST_F(AlignmentRos, ReplayBroadcastsTheTruthAndTheServicesWork) {
       test::runTool(std::string(CALIBRATE_BAG_EXE) + " --quiet --bag " + bag + " --target " +
                     TARGET_YAML + " --output " + offline);
   ASSERT_EQ(tool.exit_code, 0) << tool.err;
-  EXPECT_LT(angleDeg(readResultYaml(offline).R_cam_imu, toMatrix(calibrate.response.q_cam_imu)),
+  EXPECT_LT(test::angleBetweenDeg(readResultYaml(offline).R_cam_imu,
+                                  toMatrix(calibrate.response.q_cam_imu)),
             0.01);
 
   std_srvs::Trigger save;
@@ -305,7 +298,7 @@ TEST_F(AlignmentRos, ReplayBroadcastsTheTruthAndTheServicesWork) {
   ASSERT_TRUE(save.response.success) << save.response.message;
   std::string output;
   ASSERT_TRUE(ros::param::get(kNode + "/output_file", output));
-  EXPECT_LT(angleDeg(readResultYaml(output).R_cam_imu, R_true), 0.2);
+  EXPECT_LT(test::angleBetweenDeg(readResultYaml(output).R_cam_imu, R_true), 0.2);
   // What is saved is the broadcast estimate with its own quality: its poses, not the window's.
   const auto broadcast_status =
       waitForStatus(10.0, [](const AlignmentStatus& s) { return s.has_broadcast; });
@@ -348,14 +341,14 @@ TEST_F(AlignmentRos, ReplayBroadcastsTheTruthAndTheServicesWork) {
   ASSERT_TRUE(restarted.started());
   const auto restored = waitForTf(buffer_, "restored_cam", "restored_imu", 30.0);
   ASSERT_TRUE(restored) << restarted.log();
-  EXPECT_LT(angleDeg(*restored, R_true), 0.2);
+  EXPECT_LT(test::angleBetweenDeg(*restored, R_true), 0.2);
   // Its status shows the loaded rotation and where it came from.
   const auto loaded = waitForStatus(
       15.0, [](const AlignmentStatus& s) { return s.has_broadcast; }, "/restarted");
   ASSERT_TRUE(loaded) << restarted.log();
   EXPECT_EQ(loaded->state, AlignmentStatus::CALIBRATED) << loaded->message;
   EXPECT_EQ(loaded->broadcast_source, "loaded: " + saved);
-  EXPECT_LT(angleDeg(toMatrix(loaded->q_broadcast), R_true), 0.2);
+  EXPECT_LT(test::angleBetweenDeg(toMatrix(loaded->q_broadcast), R_true), 0.2);
   EXPECT_GT(loaded->broadcast_poses, 0u);
 }
 
@@ -375,11 +368,12 @@ TEST_F(AlignmentRos, AConsumerUnitsRemountBeforeTheFirstBroadcastIsFollowed) {
                                remapsUnder("consumer"));
   ASSERT_TRUE(consumer.started()) << consumer.log();
   auto player = play(bag, 3.0, remapsUnder("consumer"));
-  const auto R = waitForTf(buffer_, "consumer_cam", "consumer_imu", 240.0,
-                           [&](const Eigen::Matrix3d& r) { return angleDeg(r, R_after) < 0.2; });
+  const auto R =
+      waitForTf(buffer_, "consumer_cam", "consumer_imu", 240.0,
+                [&](const Eigen::Matrix3d& r) { return test::angleBetweenDeg(r, R_after) < 0.2; });
   EXPECT_EQ(player.get(), 0);
   ASSERT_TRUE(R) << consumer.log();
-  EXPECT_LT(angleDeg(*R, R_after), 0.2);
+  EXPECT_LT(test::angleBetweenDeg(*R, R_after), 0.2);
   const auto status = waitForStatus(
       10.0, [](const AlignmentStatus& s) { return s.remounts >= 1u; }, "/consumer");
   ASSERT_TRUE(status) << consumer.log();
@@ -396,11 +390,12 @@ TEST_F(AlignmentRos, RemountReconvergesToTheNewMounting) {
   const std::string stem = bag.substr(0, bag.size() - 4);
   const Eigen::Matrix3d R_after = readResultYaml(stem + ".truth.yaml").R_cam_imu;
   auto player = play(bag, 3.0);
-  const auto R = waitForTf(buffer_, "camera_optical_frame", "imu_link", 240.0,
-                           [&](const Eigen::Matrix3d& r) { return angleDeg(r, R_after) < 0.3; });
+  const auto R =
+      waitForTf(buffer_, "camera_optical_frame", "imu_link", 240.0,
+                [&](const Eigen::Matrix3d& r) { return test::angleBetweenDeg(r, R_after) < 0.3; });
   EXPECT_EQ(player.get(), 0);
   ASSERT_TRUE(R);
-  EXPECT_LT(angleDeg(*R, R_after), 0.3);
+  EXPECT_LT(test::angleBetweenDeg(*R, R_after), 0.3);
 }
 
 TEST_F(AlignmentRos, ManualCaptureTakesOnlyTheArmedRest) {
@@ -487,7 +482,7 @@ TEST_F(AlignmentRos, AnInstanceThatCannotStartSaysWhyAndItsStartFails) {
       ASSERT_TRUE(ros::service::call("/" + manager + "/list", list));
       EXPECT_TRUE(list.response.nodelets.empty()) << "an empty shell stayed loaded";
       std::system(("kill $(cat " + temp(manager + ".pid") + ")").c_str());
-      log = test::readTextFile(manager_log) + load.out + load.err;
+      log = test::readFile(manager_log) + load.out + load.err;
     }
     EXPECT_NE(log.find("/" + name + ": cannot start: "), std::string::npos) << log;
     for (const std::string& text : expected) {
@@ -517,10 +512,9 @@ TEST_F(AlignmentRos, TheLaunchFileClearsParametersLeftByAnEarlierRun) {
   const bool stale_key_left = ros::param::has("/stale/min_pose");
   std::system(("kill -INT $(cat " + pid + ")").c_str());
   ros::WallDuration(3.0).sleep();
-  EXPECT_TRUE(status) << test::readTextFile(log);
+  EXPECT_TRUE(status) << test::readFile(log);
   EXPECT_FALSE(stale_key_left);
-  EXPECT_EQ(test::readTextFile(log).find("unknown key"), std::string::npos)
-      << test::readTextFile(log);
+  EXPECT_EQ(test::readFile(log).find("unknown key"), std::string::npos) << test::readFile(log);
 }
 
 TEST_F(AlignmentRos, CompressedImagesThroughItsOwnSubscription) {
@@ -802,10 +796,10 @@ TEST_F(AlignmentRos, InputsStoppingAndComingBackAndAnUnwritableOutput) {
   ASSERT_TRUE(status) << node.log();
   EXPECT_GE(status->poses_total, 6u) << node.log();
   EXPECT_LT(status->poses_total, 12u);  // the holds without camera or IMU gave no pose
-  EXPECT_LT(angleDeg(toMatrix(status->q_cam_imu), R_true), 0.3);
+  EXPECT_LT(test::angleBetweenDeg(toMatrix(status->q_cam_imu), R_true), 0.3);
   const auto R = waitForTf(buffer_, "sg_cam", "sg_imu", 10.0);
   ASSERT_TRUE(R) << node.log();
-  EXPECT_LT(angleDeg(*R, R_true), 0.3);
+  EXPECT_LT(test::angleBetweenDeg(*R, R_true), 0.3);
 
   std_srvs::Trigger save;
   ASSERT_TRUE(ros::service::call("/stop_go/save", save));
@@ -820,7 +814,7 @@ TEST_F(AlignmentRos, InputsStoppingAndComingBackAndAnUnwritableOutput) {
                                             : std::string::npos,
             std::string::npos);
   EXPECT_GE(countOf(values, "imu gaps"), 1);
-  EXPECT_EQ(test::readTextFile(blocker), "a file where the output's directory should be\n");
+  EXPECT_EQ(test::readFile(blocker), "a file where the output's directory should be\n");
   EXPECT_TRUE(node.alive()) << node.log();
 }
 

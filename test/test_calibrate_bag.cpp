@@ -22,19 +22,14 @@ const std::string kCalibrate = CALIBRATE_BAG_EXE;
 const std::string kSimulate = SIMULATE_BAG_EXE;
 const std::string kRealData = REALDATA_DIR;
 
-std::string temp(const std::string& name) { return test::processTempDir() + name; }
+std::string temp(const std::string& name) { return test::tempPath(name); }
 
 /// Simulates a bag (scenario + extra options) and returns its path.
 std::string simulate(const std::string& name, const std::string& options) {
-  const std::string bag = temp(name + ".bag");
-  // 5 Hz instead of the default 15: a third of the bag size and rendering, same information.
-  const test::ToolRun r =
-      test::runTool(kSimulate + " --out " + bag + " --camera-rate-hz 5 " + options);
-  EXPECT_EQ(r.exit_code, 0) << r.err;
-  return bag;
+  return test::simulateBag(kSimulate, name, options);
 }
 
-std::string stem(const std::string& bag) { return bag.substr(0, bag.size() - 4); }
+std::string stem(const std::string& bag) { return test::bagStem(bag); }
 
 void removeBag(const std::string& bag) {
   std::filesystem::remove(bag);
@@ -130,7 +125,7 @@ TEST(CalibrateBag, ImuGradesWithTheDefaultPriors) {
   const YAML::Node result = YAML::LoadFile(temp("result.yaml"));
   const YAML::Node bias = result["imu_intrinsics"]["accel_bias_m_s2"];
   const YAML::Node per_pose = result["imu_intrinsics"]["accel_bias_per_pose_m_s2"];
-  ASSERT_TRUE(per_pose && per_pose.IsSequence()) << test::readTextFile(temp("result.yaml"));
+  ASSERT_TRUE(per_pose && per_pose.IsSequence()) << test::readFile(temp("result.yaml"));
   EXPECT_EQ(per_pose.size(), result["quality"]["num_poses"].as<std::size_t>());
   const auto first = bias["value"].as<std::vector<double>>();
   const auto sigma = bias["sigma"].as<std::vector<double>>();
@@ -200,7 +195,7 @@ TEST(CalibrateBag, ExportedPosesGiveSolveRotationTheSameAnswer) {
   ASSERT_EQ(result.run.exit_code, 0) << result.run.err;
   const test::ToolRun solve =
       test::runTool(std::string(SOLVE_ROTATION_EXE) + " --poses " + poses + " --output " + solved);
-  ASSERT_EQ(solve.exit_code, 0) << solve.err << test::readTextFile(poses);
+  ASSERT_EQ(solve.exit_code, 0) << solve.err << test::readFile(poses);
   const YAML::Node yaml = YAML::LoadFile(solved);
   EXPECT_EQ(yaml["quality"]["num_poses"].as<int>(), 6);
   EXPECT_EQ(yaml["quality"]["num_pairs"].as<int>(), 15);

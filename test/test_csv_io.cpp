@@ -24,9 +24,7 @@ namespace {
 const std::string& tempDir() { return test::processTempDir(); }
 
 std::string writeTemp(const std::string& name, const std::string& text) {
-  const std::string path = tempDir() + name;
-  std::ofstream(path, std::ios::binary) << text;
-  return path;
+  return test::writeTempFile(name, text);
 }
 
 const Eigen::Vector3d kX = Eigen::Vector3d::UnitX(), kY = Eigen::Vector3d::UnitY(),

@@ -1,5 +1,7 @@
-// Test helpers: random rotations, noise and rotation comparisons, independent of the library's own
-// example generator (tests build their truth themselves).
+// Test helpers, the one home of what several tests need: random rotations, noise and rotation
+// comparisons, independent of the library's own example generator and rotation math (tests build
+// their truth themselves); the per-process temporary directory and text files. Running the tools:
+// tool_runner.h; simulated runs through the pipeline: pipeline_simulation.h.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -8,6 +10,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 
@@ -108,6 +112,22 @@ inline const std::string& processTempDir() {
   };
   static const TempDir dir;
   return dir.path;
+}
+
+/// `name` in processTempDir().
+inline std::string tempPath(const std::string& name) { return processTempDir() + name; }
+
+/// The whole file (binary); "" when it cannot be read.
+inline std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+/// Writes `text` to tempPath(name) and returns that path.
+inline std::string writeTempFile(const std::string& name, const std::string& text) {
+  const std::string path = tempPath(name);
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
 }
 
 #define EXPECT_ROTATION_NEAR_DEG(R1, R2, tol_deg) \

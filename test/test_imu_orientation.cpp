@@ -14,6 +14,7 @@
 #include "camera_imu_alignment/inertial/stationary_detector.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "synthetic_imu.h"
+#include "test_helpers.h"
 
 namespace camera_imu_alignment {
 namespace {
@@ -27,10 +28,6 @@ Eigen::Matrix3d randomRotation(std::mt19937& rng) {
   return q.normalized().toRotationMatrix();
 }
 
-double angleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
-  return rad2deg(rotationAngle(a.transpose() * b));
-}
-
 // ------------------------------------------------------------------------------------------
 // Attitude at rest
 // ------------------------------------------------------------------------------------------
@@ -42,7 +39,7 @@ TEST(AttitudeFromAccelMag, ExactOnNoiseFreeVectorsAtAnyOrientation) {
     const AttitudeFromVectors a = attitudeFromAccelMag(R_world_imu.transpose() * kUpSpecificForce,
                                                        R_world_imu.transpose() * kEarthField);
     ASSERT_TRUE(a.valid);
-    EXPECT_LT(angleDeg(a.R_world_imu, R_world_imu), 1e-7);
+    EXPECT_LT(test::angleBetweenDeg(a.R_world_imu, R_world_imu), 1e-7);
     EXPECT_NEAR(a.dip_deg, rad2deg(std::atan2(42.0, 22.0)), 1e-7);
     EXPECT_NEAR(a.field_norm_t, kEarthField.norm(), 1e-15);
   }
@@ -58,7 +55,7 @@ TEST(AttitudeFromAccelMag, DisturbedFieldChangesTheHeadingOnlyAndDegenerateInput
   ASSERT_TRUE(a.valid);
   // Gravity is still exact: the up axis agrees; the error is a rotation about it.
   EXPECT_LT((a.R_world_imu * accel).normalized().cross(Eigen::Vector3d::UnitZ()).norm(), 1e-9);
-  EXPECT_GT(angleDeg(a.R_world_imu, R_world_imu), 5.0);
+  EXPECT_GT(test::angleBetweenDeg(a.R_world_imu, R_world_imu), 5.0);
   EXPECT_FALSE(attitudeFromAccelMag(accel, Eigen::Vector3d::Zero()).valid);
   EXPECT_FALSE(attitudeFromAccelMag(accel, 3e-5 * accel.normalized()).valid);  // parallel
   EXPECT_FALSE(attitudeFromAccelMag(Eigen::Vector3d(NAN, 0, 9.8), bad_field).valid);
@@ -92,10 +89,10 @@ TEST(IntegrateGyro, ConstantRateGivesTheExponentialWithBiasRemovedAndEndsClipped
   const auto samples = constantRate(rate, bias, 0.0, 3.0, 0.005);
   Eigen::Matrix3d R;
   ASSERT_TRUE(integrateGyro(samples, bias, 0.5, 2.0, &R));
-  EXPECT_LT(angleDeg(R, expSO3(rate * 1.5)), 1e-9);
+  EXPECT_LT(test::angleBetweenDeg(R, expSO3(rate * 1.5)), 1e-9);
   // Times between samples: the ends are clipped exactly.
   ASSERT_TRUE(integrateGyro(samples, bias, 0.5012, 2.0031, &R));
-  EXPECT_LT(angleDeg(R, expSO3(rate * (2.0031 - 0.5012))), 1e-9);
+  EXPECT_LT(test::angleBetweenDeg(R, expSO3(rate * (2.0031 - 0.5012))), 1e-9);
 }
 
 TEST(IntegrateGyro, TimeVaryingRateConvergesAtSecondOrder) {
@@ -108,7 +105,7 @@ TEST(IntegrateGyro, TimeVaryingRateConvergesAtSecondOrder) {
   }
   Eigen::Matrix3d R;
   ASSERT_TRUE(integrateGyro(samples, Eigen::Vector3d::Zero(), 0.0, 2.0, &R));
-  EXPECT_LT(angleDeg(R, expSO3(0.8 * 2.0 * 2.0 / 2.0 * axis)), 1e-9);
+  EXPECT_LT(test::angleBetweenDeg(R, expSO3(0.8 * 2.0 * 2.0 / 2.0 * axis)), 1e-9);
 }
 
 TEST(IntegrateGyro, GapsAndMissingCoverageFail) {
@@ -460,7 +457,7 @@ TEST_P(Broad, DetectorAgreesWithTheAuthorsLabelsAndAttitudeWithTheReference) {
   for (std::size_t k = 1; k < ours.size(); ++k) {
     const Eigen::Matrix3d B_ours = ours[0].transpose() * ours[k];
     const Eigen::Matrix3d B_ref = ref[0].transpose() * ref[k];
-    worst = std::max(worst, angleDeg(B_ours, B_ref));
+    worst = std::max(worst, test::angleBetweenDeg(B_ours, B_ref));
   }
   std::cout << GetParam() << ": worst relative attitude error " << worst << " deg over "
             << ours.size() << " rests\n";

@@ -13,6 +13,7 @@
 #include "camera_imu_alignment/simulation/trajectory.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "pipeline_simulation.h"
+#include "test_helpers.h"
 
 namespace camera_imu_alignment {
 namespace {
@@ -100,10 +101,6 @@ OnlineSettings synchronous() {
   return s;
 }
 
-double errorDeg(const Eigen::Matrix3d& R, const Eigen::Matrix3d& truth) {
-  return rad2deg(geodesicDistance(R, truth));
-}
-
 TEST(OnlineCalibrator, BroadcastsWithinATenthOfADegreeForEachGrade) {
   for (sim::ImuGrade grade :
        {sim::ImuGrade::kIdeal, sim::ImuGrade::kTactical, sim::ImuGrade::kConsumer}) {
@@ -111,7 +108,9 @@ TEST(OnlineCalibrator, BroadcastsWithinATenthOfADegreeForEachGrade) {
     const OnlineCalibrator& c = *run->calibrator;
     ASSERT_TRUE(c.broadcast().has_value()) << toString(grade) << ": " << c.stateMessage();
     EXPECT_EQ(c.state(), CalibrationState::kCalibrated) << c.stateMessage();
-    EXPECT_LT(errorDeg(c.broadcast()->R_cam_imu, run->simulated->trajectory.R_cam_imu_final()), 0.2)
+    EXPECT_LT(test::angleBetweenDeg(c.broadcast()->R_cam_imu,
+                                    run->simulated->trajectory.R_cam_imu_final()),
+              0.2)
         << toString(grade);
     EXPECT_EQ(c.snapshot().remounts, 0) << toString(grade);
     // What is broadcast carries its own quality: the poses and 1-sigma of that estimate.
@@ -178,7 +177,7 @@ TEST(OnlineCalibrator, RemountBeforeTheFirstBroadcastIsFoundWithinThreePoses) {
       ASSERT_GT(new_mount_broadcasts, 0) << what << ": " << run->calibrator->stateMessage();
       const BroadcastEstimate& b = *run->calibrator->broadcast();
       if (!noisy) {
-        EXPECT_LT(errorDeg(b.R_cam_imu, truth_after), 0.2) << what;
+        EXPECT_LT(test::angleBetweenDeg(b.R_cam_imu, truth_after), 0.2) << what;
         continue;
       }
       // Per camera axis within 3 of its reported 1-sigma (left perturbation, camera axes).
@@ -191,8 +190,8 @@ TEST(OnlineCalibrator, RemountBeforeTheFirstBroadcastIsFoundWithinThreePoses) {
       }
       std::printf(
           "%s: broadcast %.3f deg off the new mount, 1-sigma [%.3f %.3f %.3f] deg, %d poses\n",
-          what.c_str(), errorDeg(b.R_cam_imu, truth_after), b.std_dev_deg(0), b.std_dev_deg(1),
-          b.std_dev_deg(2), b.poses);
+          what.c_str(), test::angleBetweenDeg(b.R_cam_imu, truth_after), b.std_dev_deg(0),
+          b.std_dev_deg(1), b.std_dev_deg(2), b.poses);
     }
   }
 }
@@ -212,8 +211,8 @@ TEST(OnlineCalibrator, ATacticalUnitsTurnIsFoundAlthoughTheMixedWindowDropsItsMa
     EXPECT_EQ(r.remounts.front().first_pose_index, 7) << "seed " << seed;
     EXPECT_LE(r.poses_at_remount.front() - 7, 3) << "seed " << seed;
     ASSERT_TRUE(run->calibrator->broadcast().has_value()) << "seed " << seed;
-    EXPECT_LT(errorDeg(run->calibrator->broadcast()->R_cam_imu,
-                       run->simulated->trajectory.R_cam_imu_final()),
+    EXPECT_LT(test::angleBetweenDeg(run->calibrator->broadcast()->R_cam_imu,
+                                    run->simulated->trajectory.R_cam_imu_final()),
               0.2)
         << "seed " << seed;
   }
@@ -308,8 +307,8 @@ TEST(OnlineCalibrator, PairModesKeepTheResidualRemountTest) {
   ASSERT_EQ(r.remounts.size(), 1u) << run->calibrator->stateMessage();
   EXPECT_NE(r.remounts[0].message.find("remount_residual_deg"), std::string::npos);
   ASSERT_TRUE(run->calibrator->broadcast().has_value());
-  EXPECT_LT(errorDeg(run->calibrator->broadcast()->R_cam_imu,
-                     run->simulated->trajectory.R_cam_imu_final()),
+  EXPECT_LT(test::angleBetweenDeg(run->calibrator->broadcast()->R_cam_imu,
+                                  run->simulated->trajectory.R_cam_imu_final()),
             0.3);
 }
 
@@ -393,8 +392,8 @@ TEST(OnlineCalibrator, TheWorkerThreadGivesTheSameFinalEstimate) {
   const auto threaded_run = calibrate(config, threaded);
   ASSERT_TRUE(inline_run->calibrator->lastEstimate().has_value());
   ASSERT_TRUE(threaded_run->calibrator->lastEstimate().has_value());
-  EXPECT_LT(errorDeg(inline_run->calibrator->lastEstimate()->result.R_cam_imu,
-                     threaded_run->calibrator->lastEstimate()->result.R_cam_imu),
+  EXPECT_LT(test::angleBetweenDeg(inline_run->calibrator->lastEstimate()->result.R_cam_imu,
+                                  threaded_run->calibrator->lastEstimate()->result.R_cam_imu),
             1e-9);
   EXPECT_TRUE(threaded_run->calibrator->broadcast().has_value());
 }

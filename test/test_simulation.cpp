@@ -16,6 +16,7 @@
 #include "camera_imu_alignment/simulation/simulation_run.h"
 #include "camera_imu_alignment/simulation/target.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
+#include "test_helpers.h"
 
 namespace camera_imu_alignment {
 namespace simulation {
@@ -27,10 +28,6 @@ SimulationConfig shortConfig(const std::string& scenario = "nominal", std::uint6
   EXPECT_TRUE(applyScenario(scenario, &c));
   c.num_poses = std::min(c.num_poses, 6);
   return c;
-}
-
-double angleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
-  return rad2deg(geodesicDistance(a, b));
 }
 
 /// Integrates gyro - true bias from the middle of hold a to the middle of hold b (midpoint rule on
@@ -55,9 +52,12 @@ TEST(Simulation, SameSeedSameDataOtherSeedOtherData) {
   }
   EXPECT_EQ(truthYaml(a), truthYaml(b));
   EXPECT_NE(truthYaml(a), truthYaml(other));
-  EXPECT_GT(angleDeg(a.trajectory.R_cam_imu_final(), other.trajectory.R_cam_imu_final()), 1.0);
+  EXPECT_GT(
+      test::angleBetweenDeg(a.trajectory.R_cam_imu_final(), other.trajectory.R_cam_imu_final()),
+      1.0);
   // A random mounting is never near the identity.
-  EXPECT_GT(angleDeg(a.trajectory.R_cam_imu_final(), Eigen::Matrix3d::Identity()), 30.0);
+  EXPECT_GT(test::angleBetweenDeg(a.trajectory.R_cam_imu_final(), Eigen::Matrix3d::Identity()),
+            30.0);
 }
 
 TEST(Simulation, RotationPairsSatisfyAXEqualsXB) {
@@ -70,7 +70,7 @@ TEST(Simulation, RotationPairsSatisfyAXEqualsXB) {
     const Eigen::Matrix3d A = (tr.R_world_target().transpose() * sk.R_world_cam).transpose() *
                               (tr.R_world_target().transpose() * st.R_world_cam);
     const Eigen::Matrix3d B = sk.R_world_imu().transpose() * st.R_world_imu();
-    EXPECT_LT(angleDeg(A * X, X * B), 1e-9);
+    EXPECT_LT(test::angleBetweenDeg(A * X, X * B), 1e-9);
     EXPECT_GT(rotationAngle(A), deg2rad(5.0)) << "poses must differ";
   }
 }
@@ -87,7 +87,7 @@ TEST(Simulation, IntegratedGyroReproducesTrueRelativeRotations) {
       const Eigen::Matrix3d truth =
           run.trajectory.at(ta).R_world_imu().transpose() * run.trajectory.at(tb).R_world_imu();
       const double tol = noise == 0.0 ? 0.01 : 0.2;
-      EXPECT_LT(angleDeg(integrateGyro(run.imu, ta, tb), truth), tol)
+      EXPECT_LT(test::angleBetweenDeg(integrateGyro(run.imu, ta, tb), truth), tol)
           << "noise " << noise << " poses " << k << "-" << k + 1;
     }
   }
@@ -99,10 +99,10 @@ TEST(Simulation, RemountIsSeenByTheGyroAndRecorded) {
   const SimulationRun run(c);
   const Trajectory& tr = run.trajectory;
   ASSERT_TRUE(tr.remount());
-  EXPECT_NEAR(angleDeg(tr.R_cam_imu_initial(), tr.R_cam_imu_final()), 10.0, 1e-6);
+  EXPECT_NEAR(test::angleBetweenDeg(tr.R_cam_imu_initial(), tr.R_cam_imu_final()), 10.0, 1e-6);
   const double ta = tr.poses().front().start_s + 0.1, tb = tr.poses().back().end_s - 0.1;
   const Eigen::Matrix3d truth = tr.at(ta).R_world_imu().transpose() * tr.at(tb).R_world_imu();
-  EXPECT_LT(angleDeg(integrateGyro(run.imu, ta, tb), truth), 0.02);
+  EXPECT_LT(test::angleBetweenDeg(integrateGyro(run.imu, ta, tb), truth), 0.02);
   const YAML::Node y = YAML::Load(truthYaml(run));
   EXPECT_TRUE(y["remount"]["enabled"].as<bool>());
   EXPECT_TRUE(y["remount"]["R_cam_imu_before"]["quaternion_xyzw"]);
@@ -139,7 +139,7 @@ TEST(Simulation, AccelerometerAndMagnetometerAgreeWithTrueAttitudeAtRest) {
       return R;  // columns: world east, north, up in the sensor frame
     };
     const Eigen::Matrix3d R_imu_world = triad(acc, mag);
-    EXPECT_LT(angleDeg(R_imu_world.transpose(), R_world_imu), 0.2);
+    EXPECT_LT(test::angleBetweenDeg(R_imu_world.transpose(), R_world_imu), 0.2);
   }
 }
 
@@ -289,7 +289,7 @@ TEST(Simulation, TruthYamlIsReadableAndComplete) {
   const std::string path = ::testing::TempDir() + "cia_sim_truth.yaml";
   std::ofstream(path) << truthYaml(run);
   const StoredCalibration stored = readResultYaml(path);
-  EXPECT_LT(angleDeg(stored.R_cam_imu, run.trajectory.R_cam_imu_final()), 1e-6);
+  EXPECT_LT(test::angleBetweenDeg(stored.R_cam_imu, run.trajectory.R_cam_imu_final()), 1e-6);
   const YAML::Node y = YAML::LoadFile(path);
   ASSERT_EQ(y["stationary_intervals"].size(), run.trajectory.poses().size());
   ASSERT_EQ(y["poses"].size(), run.trajectory.poses().size());

@@ -1,49 +1,31 @@
 // simulate_bag end to end: usage and exit codes, the three files, same seed -> same bag bytes, and
 // `rosbag info --yaml --freq` showing the expected topics, message counts and rates.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cstdio>
 #include <fstream>
-#include <iterator>
 #include <map>
 #include <string>
 #include <utility>
 
 #include "camera_imu_alignment/io/result_yaml.h"
+#include "tool_runner.h"
 
 namespace camera_imu_alignment {
 namespace {
 
-struct RunResult {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-RunResult run(const std::string& args) {
-  const std::string dir = ::testing::TempDir();
-  const std::string out = dir + "cia_simbag_stdout.txt", err = dir + "cia_simbag_stderr.txt";
-  const int status = std::system(("timeout 120 " + args + " >" + out + " 2>" + err).c_str());
-  RunResult r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = readFile(out);
-  r.err = readFile(err);
-  return r;
-}
+using RunResult = test::ToolRun;
+using test::readFile;
+RunResult run(const std::string& args) { return test::runTool(args, 120); }
 
 const std::string kSim = SIMULATE_BAG_EXE;
 // A short run: 3 poses of 1-1.5 s joined by 1-1.5 s motions.
 const std::string kShort =
     " --num-poses 3 --hold-min-s 1 --hold-max-s 1.5 --move-min-s 1 --move-max-s 1.5";
 
-std::string temp(const std::string& name) { return ::testing::TempDir() + "cia_simbag_" + name; }
+std::string temp(const std::string& name) { return test::tempPath(name); }
 
 TEST(SimulateBag, HelpListsEveryScenario) {
   const RunResult r = run(kSim + " --help");

@@ -1,7 +1,6 @@
 // solve_rotation end to end: the real binary, its exit codes (0 ok, 2 bad input, 3 not observable),
 // messages naming the file/line/axis, and results against known truths.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cstdlib>
@@ -14,6 +13,7 @@
 #include "camera_imu_alignment/io/result_yaml.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "test_helpers.h"
+#include "tool_runner.h"
 
 namespace camera_imu_alignment {
 namespace {
@@ -23,37 +23,13 @@ const std::string kGenerate = GENERATE_EXAMPLE_EXE;
 const std::string kData = TEST_DATA_DIR;
 
 const std::string& tempDir() { return test::processTempDir(); }
-
-std::string temp(const std::string& name) { return tempDir() + name; }
-
+std::string temp(const std::string& name) { return test::tempPath(name); }
 std::string writeFile(const std::string& name, const std::string& text) {
-  const std::string path = temp(name);
-  std::ofstream(path, std::ios::binary) << text;
-  return path;
+  return test::writeTempFile(name, text);
 }
-
-std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-struct RunResult {
-  int exit_code = -1;  ///< -1: killed by a signal (a crash); 124: timed out
-  std::string out;
-  std::string err;
-};
-
-/// Runs a command under `timeout` (a hang fails the test instead of blocking it).
-RunResult run(const std::string& args) {
-  const std::string out_path = temp("stdout.txt"), err_path = temp("stderr.txt");
-  const std::string cmd = "timeout 60 " + args + " >" + out_path + " 2>" + err_path;
-  const int status = std::system(cmd.c_str());
-  RunResult r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = readFile(out_path);
-  r.err = readFile(err_path);
-  return r;
-}
+using test::readFile;
+using RunResult = test::ToolRun;
+RunResult run(const std::string& args) { return test::runTool(args, 60); }
 
 Eigen::Matrix3d resultRotation(const std::string& yaml_text) {
   const auto q = YAML::Load(yaml_text)["R_cam_imu"]["quaternion_xyzw"].as<std::vector<double>>();

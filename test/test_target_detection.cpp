@@ -22,15 +22,12 @@
 #include "camera_imu_alignment/vision/camera_pose.h"
 #include "camera_imu_alignment/vision/target_description.h"
 #include "camera_imu_alignment/vision/target_detector.h"
+#include "test_helpers.h"
 
 namespace camera_imu_alignment {
 namespace {
 
 using simulation::SimulationConfig;
-
-double angleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
-  return Eigen::AngleAxisd(a.transpose() * b).angle() * 180.0 / M_PI;
-}
 
 // ------------------------------------------------------------------------------ target YAML
 
@@ -258,7 +255,7 @@ double maxRotationErrorDeg(const SimulationConfig& c, const std::vector<Rendered
     }
     ++*num_found;
     *max_rms_px = std::max(*max_rms_px, pose->reprojection_rms_px);
-    worst = std::max(worst, angleDeg(pose->R_target_cam, v.R_target_cam));
+    worst = std::max(worst, test::angleBetweenDeg(pose->R_target_cam, v.R_target_cam));
   }
   return worst;
 }
@@ -346,7 +343,7 @@ TEST(RenderedTargets, SymmetricBoardFollowsTheHintThroughAHalfTurn) {
     std::string why;
     const auto pose = estimateCameraPose(obs, target, intrinsics, PoseSettings(), &why);
     ASSERT_TRUE(pose) << why;
-    EXPECT_LT(angleDeg(pose->R_target_cam, v.R_target_cam), 0.05);
+    EXPECT_LT(test::angleBetweenDeg(pose->R_target_cam, v.R_target_cam), 0.05);
   }
 }
 
@@ -388,7 +385,7 @@ TEST(RenderedTargets, PartialAprilGridWithFourTagsIsUsable) {
     ASSERT_TRUE(pose) << why;
     // Half the board: fewer points over a smaller area (measured 0.12-0.18 deg); a wrong tag
     // or corner labelling would be off by degrees.
-    EXPECT_LT(angleDeg(pose->R_target_cam, v.R_target_cam), 0.3);
+    EXPECT_LT(test::angleBetweenDeg(pose->R_target_cam, v.R_target_cam), 0.3);
   }
 }
 
@@ -473,7 +470,7 @@ TEST(VispRealImages, AllChessboardsFoundAndRotationMatchesVisp) {
   Eigen::Matrix3d R_imu_cam_visp;
   R_imu_cam_visp << -0.0110121, -0.999915, 0.0069391, 0.999929, -0.0109794, 0.00473584, -0.00465925,
       0.00699075, 0.999965;
-  const double error_deg = angleDeg(result.R_cam_imu, R_imu_cam_visp.transpose());
+  const double error_deg = test::angleBetweenDeg(result.R_cam_imu, R_imu_cam_visp.transpose());
   std::cout << "ViSP Franka: R_cam_imu differs from ViSP's estimate by " << error_deg << " deg\n";
   EXPECT_LT(error_deg, 0.1);
 }
