@@ -53,6 +53,7 @@ std::string AlignmentWrapper::Impl::imuFrame() const {
 }
 
 void AlignmentWrapper::Impl::onBroadcast(const BroadcastEstimate& estimate) {
+  noteReplacedBroadcast(estimate);
   sendTransform(estimate.R_cam_imu);
   if (estimate.source != "estimated" || settings.output_file.empty()) {
     publishStatus();
@@ -94,6 +95,7 @@ bool AlignmentWrapper::Impl::save(const BroadcastEstimate& estimate, std::string
   try {
     // The broadcast estimate with its own quality: the poses behind it, not the window's now.
     ResultMetadata meta{cameraFrame(), imuFrame(), estimate.poses};
+    backUpOutputOnce();
     writeResultYaml(settings.output_file, *estimate.result, meta);
     return true;
   } catch (const std::exception& e) {
