@@ -258,7 +258,7 @@ int run(const cia::CliArgs& args) {
     report.verdict = cia::ReportVerdict{gates_passed, text};
   }
   std::cout << cia::formatSummary(report);
-  if (truth) {
+  if (truth && report.result.status != cia::SolveStatus::kBadInput) {  // else: no estimate
     std::cout << std::fixed << std::setprecision(4) << "error to " << args.get("--truth") << ": "
               << cia::rad2deg(cia::geodesicDistance(report.result.R_cam_imu, truth->R_cam_imu))
               << " deg\n";
@@ -284,6 +284,11 @@ int run(const cia::CliArgs& args) {
   const cia::SolveStatus status = report.result.status;
   if (status != cia::SolveStatus::kOk) {
     std::cerr << "calibrate_bag: " << report.result.message << "\n";
+    const std::string target_problem = pipeline.targetNotFoundDiagnosis();
+    if (!target_problem.empty()) {  // the target file, not the recording
+      std::cerr << "calibrate_bag: " << args.get("--target") << ": " << target_problem << "\n";
+      return kExitBadInput;
+    }
     return kExitNotEnoughInformation;  // the bag was read; it did not hold enough information
   }
   if (!gates_passed) {

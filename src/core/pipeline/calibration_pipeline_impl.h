@@ -56,6 +56,7 @@ struct CalibrationPipeline::Impl {
   std::optional<double> misses_rest;  ///< start of the rest they belong to
   std::uint64_t num_imu = 0, num_mag = 0, num_frames = 0, num_detected = 0;
   std::uint64_t frames_without_intrinsics = 0, frames_dropped = 0;
+  std::string target_mismatch;  ///< the detector's latest TargetObservation::mismatch
 
   // --- IMU orientation chain (see the rule in calibration_pipeline.h)
   bool chain_valid = false;
