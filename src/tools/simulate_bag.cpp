@@ -118,8 +118,9 @@ std::string usage() {
        "  --width (640) --height (480) --fx --fy (500) --cx --cy (centre)  --distortion "
        "k1,k2,p1,p2,k3\n"
        "  --blur-sigma-px (0.6)  --pixel-noise (1.5)  --supersample (3)  --motion-blur-s (0)\n"
-       "  --imu-topic (imu/data_raw) --mag-topic (imu/mag) --image-topic (camera/image_raw)\n"
-       "  --camera-info-topic (camera/camera_info) --imu-frame (imu_link) --camera-frame "
+       "  --imu-topic (/imu/data_raw) --mag-topic (/imu/mag) --image-topic (/camera/image_raw)\n"
+       "  --camera-info-topic (/camera/camera_info; a relative name is made global) --imu-frame "
+       "(imu_link) --camera-frame "
        "(camera_optical_frame)\n"
        "  --mag-frame NAME --mag-frame-yaw-deg D (IMU frame, 0): magnetometer messages in frame "
        "NAME,\n"
@@ -258,10 +259,15 @@ sim::SimulationConfig configFromArgs(const cia::CliArgs& a) {
   c.pixel_noise_sigma = a.getDouble("--pixel-noise", c.pixel_noise_sigma, 0, 100);
   c.supersample = static_cast<int>(a.getInt("--supersample", c.supersample, 1, 8));
   c.motion_blur_exposure_s = a.getDouble("--motion-blur-s", c.motion_blur_exposure_s, 0, 1);
-  c.imu_topic = a.get("--imu-topic", c.imu_topic);
-  c.mag_topic = a.get("--mag-topic", c.mag_topic);
-  c.image_topic = a.get("--image-topic", c.image_topic);
-  c.camera_info_topic = a.get("--camera-info-topic", c.camera_info_topic);
+  // Bag topics are global names, as rosbag record writes them: `rosbag play --topics
+  // /camera/image_raw` matches only "/camera/image_raw", not "camera/image_raw".
+  const auto global = [](std::string topic) {
+    return topic.empty() || topic[0] == '/' ? topic : "/" + topic;
+  };
+  c.imu_topic = global(a.get("--imu-topic", c.imu_topic));
+  c.mag_topic = global(a.get("--mag-topic", c.mag_topic));
+  c.image_topic = global(a.get("--image-topic", c.image_topic));
+  c.camera_info_topic = global(a.get("--camera-info-topic", c.camera_info_topic));
   c.imu_frame = a.get("--imu-frame", c.imu_frame);
   c.camera_frame = a.get("--camera-frame", c.camera_frame);
   c.start_time_s = a.getDouble("--start-time-s", c.start_time_s, 1, 4e9);
