@@ -332,6 +332,38 @@ TEST(CalibrateBag, AWrongTargetSizeExitsTwoSayingTheBoardsSize) {
   removeBag(bag);
 }
 
+/// --start / --end read a part of the bag: fewer rests than the whole; an empty window or a
+/// value that is not a number exits 2 naming the option.
+TEST(CalibrateBag, StartAndEndReadAPartOfTheBag) {
+  const std::string bag = simulate("window", "--scenario nominal --seed 32 --num-poses 6");
+  const std::string target = " --target " + stem(bag) + ".target.yaml";
+  const auto rests = [](const std::string& err) {
+    const std::size_t at = err.find(" stationary rests");
+    const std::size_t from = err.rfind(' ', at - 1);
+    return at == std::string::npos ? -1 : std::stoi(err.substr(from + 1, at - from - 1));
+  };
+  const test::ToolRun whole = test::runTool(kCalibrate + " --quiet --bag " + bag + target);
+  const test::ToolRun half =
+      test::runTool(kCalibrate + " --quiet --bag " + bag + target + " --end 25");
+  const test::ToolRun late =
+      test::runTool(kCalibrate + " --quiet --bag " + bag + target + " --start 25");
+  ASSERT_GT(rests(whole.err), 4) << whole.err;
+  EXPECT_GT(rests(half.err), 0) << half.err;
+  EXPECT_GT(rests(late.err), 0) << late.err;
+  EXPECT_LT(rests(half.err), rests(whole.err)) << half.err;
+  EXPECT_LT(rests(late.err), rests(whole.err)) << late.err;
+  EXPECT_NE(half.err.find("reading 0 s to 25 s of the bag"), std::string::npos) << half.err;
+  const test::ToolRun empty =
+      test::runTool(kCalibrate + " --quiet --bag " + bag + target + " --start 1000");
+  EXPECT_EQ(empty.exit_code, 2);
+  EXPECT_NE(empty.err.find("--start 1000 s"), std::string::npos) << empty.err;
+  const test::ToolRun bad =
+      test::runTool(kCalibrate + " --quiet --bag " + bag + target + " --end soon");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("--end must be a number"), std::string::npos) << bad.err;
+  removeBag(bag);
+}
+
 TEST(CalibrateBag, BadUsageAndInputsExitTwoNamingTheCulprit) {
   const std::string bag = simulate("usage", "--scenario nominal --seed 30 --num-poses 3");
   const std::string target = stem(bag) + ".target.yaml";

@@ -51,6 +51,7 @@ const char* kUsage =
     "                     [--imu-orientation joint|auto|magnetometer|message]\n"
     "                     [--output RESULT.yaml] [--imu-yaml IMU.yaml] [--report REPORT.png]\n"
     "                     [--truth TRUTH.yaml] [--export-poses POSES.csv] [--quiet]\n"
+    "                     [--start S] [--end S]\n"
     "  --bag FILE.bag        ROS 1 bag: sensor_msgs/Imu, optional MagneticField, Image or\n"
     "                        CompressedImage and CameraInfo (topics found by type when not given)\n"
     "  --target TARGET.yaml  Kalibr target file (checkerboard, aprilgrid, circlegrid)\n"
@@ -71,6 +72,8 @@ const char* kUsage =
     "                        error to\n"
     "  --export-poses POSES.csv  write the stationary poses the estimate used (the window) as the\n"
     "                        poses CSV that solve_rotation --poses reads (doc/CONVENTIONS.md)\n"
+    "  --start S, --end S    read only the part of the bag from S to S (seconds from its\n"
+    "                        first message; as rosbag play --start / --duration)\n"
     "  --quiet               no progress on stderr\n"
     "exit codes: 0 success, 2 bad input or usage, 3 not enough information (the message says what\n"
     "motion is missing), 4 an estimate that fails the quality gates or a mount that moved during\n"
@@ -173,6 +176,7 @@ int run(const cia::CliArgs& args) {
     rosbag::View all(bag);
     info.start_s = all.getBeginTime().toSec();
     info.end_s = all.getEndTime().toSec();
+    if (!cia::readBagWindow(args, &info)) return kExitBadInput;
   } catch (const std::exception& e) {
     std::cerr << "calibrate_bag: " << bag_path << ": " << e.what() << "\n";
     return kExitBadInput;
@@ -317,11 +321,12 @@ int run(const cia::CliArgs& args) {
 int main(int argc, char** argv) {
   cia::CliArgs args = [&] {
     try {
-      return cia::CliArgs(argc, argv,
-                          {"--bag", "--target", "--config", "--imu-topic", "--mag-topic",
-                           "--image-topic", "--camera-info-topic", "--method", "--imu-orientation",
-                           "--output", "--imu-yaml", "--report", "--truth", "--export-poses"},
-                          {"--help", "--quiet"});
+      return cia::CliArgs(
+          argc, argv,
+          {"--bag", "--target", "--config", "--imu-topic", "--mag-topic", "--image-topic",
+           "--camera-info-topic", "--method", "--imu-orientation", "--output", "--imu-yaml",
+           "--report", "--truth", "--export-poses", "--start", "--end"},
+          {"--help", "--quiet"});
     } catch (const cia::UsageError& e) {
       std::cerr << "calibrate_bag: " << e.what() << "\n" << kUsage;
       std::exit(kExitBadInput);
