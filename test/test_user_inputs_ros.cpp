@@ -12,6 +12,7 @@
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/Imu.h>
+#include <sensor_msgs/MagneticField.h>
 #include <std_srvs/Trigger.h>
 
 #include <Eigen/Geometry>
@@ -163,7 +164,7 @@ class UserInputsRos : public ::testing::Test {
   }
 };
 
-TEST_F(UserInputsRos, SaveFalseWritesAndLoadsNothingAndBothLaunchFilesShareTheDefault) {
+TEST_F(UserInputsRos, SaveFalseWritesAndLoadsNothingTheDriverPresetSetsTopicsDefaultsAgree) {
   // output:="" cannot switch saving off (roslaunch drops an empty command-line value and uses
   // the default); save:=false does: no output_file, nothing loaded, ~save says so.
   const std::string saved = temp("nosave.yaml");
@@ -173,10 +174,16 @@ TEST_F(UserInputsRos, SaveFalseWritesAndLoadsNothingAndBothLaunchFilesShareTheDe
       "roslaunch camera_imu_alignment alignment.launch name:=nosave manager:=nosave_manager "
       "node:=" +
       std::string(g_instance_kind == "node" ? "true" : "false") + " target:=" + TARGET_YAML +
-      " output:=" + saved + " save:=false imu_topic:=/nosave/imu/data_raw " +
-      "mag_topic:=/nosave/imu/mag image_topic:=/nosave/camera/image_raw";
+      " output:=" + saved + " save:=false imu_driver:=vectornav " +
+      "image_topic:=/nosave/camera/image_raw";
   std::system((launch + " >" + log + " 2>&1 & echo $! >" + pid).c_str());
   const bool up = ros::service::waitForService("/nosave/save", ros::Duration(60.0));
+  // imu_driver:=vectornav: the driver's topics are subscribed.
+  ros::NodeHandle driver_nh;
+  const ros::Publisher imu_pub = driver_nh.advertise<sensor_msgs::Imu>("/vectornav/IMU", 1);
+  const ros::Publisher mag_pub =
+      driver_nh.advertise<sensor_msgs::MagneticField>("/vectornav/Mag", 1);
+  EXPECT_TRUE(up && connected(imu_pub) && connected(mag_pub)) << test::readTextFile(log);
   std::string output_file = "unset";
   ros::param::get("/nosave/output_file", output_file);
   std_srvs::Trigger save;
