@@ -4,6 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/Geometry>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -328,6 +329,68 @@ TEST(CalibrateBag, TruncatedBagExitsTwoWithoutCrashing) {
     EXPECT_EQ(r.exit_code, 2) << fraction << "\n" << r.err;
     EXPECT_NE(r.err.find("cut.bag"), std::string::npos) << r.err;
   }
+  removeBag(bag);
+}
+
+/// A target file one column short of the board (7x6 for the simulator's 8x6): quick (a failed
+/// detection took ~4 s per frame, 193 s for a 4 s job), no truth error for an estimate that does
+/// not exist (it printed "error 97.98 deg"), and exit 2 saying what is wrong.
+TEST(CalibrateBag, AWrongTargetSizeExitsTwoSayingTheBoardsSize) {
+  const std::string bag = simulate("wrong_size", "--scenario nominal --seed 31 --num-poses 4");
+  const std::string target = temp("wrong_size_7x6.yaml");
+  std::ofstream(target) << "target_type: checkerboard\ntargetCols: 7\ntargetRows: 6\n"
+                           "rowSpacingMeters: 0.04\ncolSpacingMeters: 0.04\n";
+  const auto start = std::chrono::steady_clock::now();
+  const test::ToolRun r = test::runTool(kCalibrate + " --quiet --bag " + bag + " --target " +
+                                        target + " --truth " + stem(bag) + ".truth.yaml");
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(target + ": the target (checkerboard"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("does the target file describe the board in view?"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("a checkerboard with 8 x 6 inner corners is in view"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.out.find("error to "), std::string::npos) << r.out;
+  const std::size_t truth_line = r.out.find("truth (");  // if any, it says n/a
+  if (truth_line != std::string::npos) {
+    EXPECT_NE(r.out.substr(truth_line, r.out.find('\n', truth_line) - truth_line).find("n/a"),
+              std::string::npos)
+        << r.out;
+  }
+  EXPECT_LT(seconds, 60.0);
+  removeBag(bag);
+}
+
+/// --start / --end read a part of the bag: fewer rests than the whole; an empty window or a
+/// value that is not a number exits 2 naming the option.
+TEST(CalibrateBag, StartAndEndReadAPartOfTheBag) {
+  const std::string bag = simulate("window", "--scenario nominal --seed 32 --num-poses 6");
+  const std::string target = " --target " + stem(bag) + ".target.yaml";
+  const auto rests = [](const std::string& err) {
+    const std::size_t at = err.find(" stationary rests");
+    const std::size_t from = err.rfind(' ', at - 1);
+    return at == std::string::npos ? -1 : std::stoi(err.substr(from + 1, at - from - 1));
+  };
+  const test::ToolRun whole = test::runTool(kCalibrate + " --quiet --bag " + bag + target);
+  const test::ToolRun half =
+      test::runTool(kCalibrate + " --quiet --bag " + bag + target + " --end 25");
+  const test::ToolRun late =
+      test::runTool(kCalibrate + " --quiet --bag " + bag + target + " --start 25");
+  ASSERT_GT(rests(whole.err), 4) << whole.err;
+  EXPECT_GT(rests(half.err), 0) << half.err;
+  EXPECT_GT(rests(late.err), 0) << late.err;
+  EXPECT_LT(rests(half.err), rests(whole.err)) << half.err;
+  EXPECT_LT(rests(late.err), rests(whole.err)) << late.err;
+  EXPECT_NE(half.err.find("reading 0 s to 25 s of the bag"), std::string::npos) << half.err;
+  const test::ToolRun empty =
+      test::runTool(kCalibrate + " --quiet --bag " + bag + target + " --start 1000");
+  EXPECT_EQ(empty.exit_code, 2);
+  EXPECT_NE(empty.err.find("--start 1000 s"), std::string::npos) << empty.err;
+  const test::ToolRun bad =
+      test::runTool(kCalibrate + " --quiet --bag " + bag + target + " --end soon");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("--end must be a number"), std::string::npos) << bad.err;
   removeBag(bag);
 }
 

@@ -326,5 +326,72 @@ TEST(JointPipeline, LocalGravityReachesTheJointEstimate) {
   EXPECT_LE(rms_local, 0.06);
 }
 
+/// Passes everything on to a pipeline except the camera frames while the rig holds `pose`: the
+/// board out of view for one hold (a capture not armed, frames rejected).
+class DropHold : public SampleSink {
+ public:
+  DropHold(const sim::SimulationRun& run, int pose, CalibrationPipeline* pipeline)
+      : run_(run), pose_(pose), pipeline_(pipeline) {}
+  void addImu(const ImuSample& s) override { pipeline_->addImu(s); }
+  void addMagnetic(const MagneticSample& s) override { pipeline_->addMagnetic(s); }
+  bool setCameraIntrinsics(const CameraIntrinsics& i) override {
+    return pipeline_->setCameraIntrinsics(i);
+  }
+  void addFrame(const CameraFrame& frame) override {
+    if (run_.trajectory.at(frame.stamp_s).pose != pose_) pipeline_->addFrame(frame);
+  }
+  void rejectInput(RejectReason reason, InputStream stream, const std::string& detail) override {
+    pipeline_->rejectInput(reason, stream, detail);
+  }
+  ImuOrientationSource imuOrientationSource() const override {
+    return pipeline_->imuOrientationSource();
+  }
+
+ private:
+  const sim::SimulationRun& run_;
+  int pose_;
+  CalibrationPipeline* pipeline_;
+};
+
+/// One hold without camera frames: that rest becomes no pose, and the gyro from the pose before it
+/// to the pose after it runs through it. Its own samples were once appended to the pending gyro
+/// segment on top of the motion's (the rest's first sample twice, then its last one again with the
+/// next motion): "gyro segment 3: stamps are not strictly increasing", and every later solve of the
+/// window failed.
+TEST(JointPipeline, AHoldWithoutCameraFramesIsBridgedByTheGyro) {
+  sim::SimulationConfig c;
+  c.seed = 3;
+  ASSERT_TRUE(sim::applyScenario("nominal", &c));
+  c.camera_rate_hz = 1.0;
+  const sim::SimulationRun run(c);
+  PipelineSettings settings;
+  settings.joint = jointSettingsFor(c);
+  int rejected = 0;
+  PipelineCallbacks callbacks;
+  callbacks.on_pose_rejected = [&rejected](const RejectedPose&) { ++rejected; };
+  CalibrationPipeline pipeline(parseTargetYaml(sim::targetYaml(c.target), "target"), settings,
+                               callbacks);
+  DropHold sink(run, 3, &pipeline);
+  test::feedSinkWithoutImages(run, &sink, 0.03, false, 103);
+  pipeline.finish();
+  EXPECT_GE(rejected, 1);
+  const AlignmentResult r = test::solveFinalWindow(pipeline);
+  ASSERT_TRUE(r.joint.has_value()) << r.message;
+  ASSERT_TRUE(r.joint->ok) << r.joint->message;
+  // Every gyro segment's stamps strictly increasing, and one of them spans the dropped hold.
+  const JointProblem problem = pipeline.snapshot().joint;
+  const sim::StationaryPose& dropped = run.trajectory.poses().at(3);
+  bool bridged = false;
+  for (const GyroSegment& g : problem.segments) {
+    for (std::size_t i = 1; i < g.stamps_s.size(); ++i) {
+      ASSERT_GT(g.stamps_s[i], g.stamps_s[i - 1]) << "sample " << i;
+    }
+    bridged |= !g.stamps_s.empty() && g.stamps_s.front() < dropped.start_s &&
+               g.stamps_s.back() > dropped.end_s;
+  }
+  EXPECT_TRUE(bridged);
+  EXPECT_LT(rad2deg(geodesicDistance(r.R_cam_imu, run.trajectory.R_cam_imu_final())), 0.05);
+}
+
 }  // namespace
 }  // namespace camera_imu_alignment

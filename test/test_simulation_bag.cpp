@@ -120,10 +120,10 @@ TEST(SimulateBag, FilesTopicsCountsAndRates) {
     const char* type;
     const char* count_key;
     double rate;
-  } expected[] = {{"imu/data_raw", "sensor_msgs/Imu", "imu", 200.0},
-                  {"imu/mag", "sensor_msgs/MagneticField", "magnetometer", 100.0},
-                  {"camera/image_raw", "sensor_msgs/Image", "images", 15.0},
-                  {"camera/camera_info", "sensor_msgs/CameraInfo", "images", 15.0}};
+  } expected[] = {{"/imu/data_raw", "sensor_msgs/Imu", "imu", 200.0},
+                  {"/imu/mag", "sensor_msgs/MagneticField", "magnetometer", 100.0},
+                  {"/camera/image_raw", "sensor_msgs/Image", "images", 15.0},
+                  {"/camera/camera_info", "sensor_msgs/CameraInfo", "images", 15.0}};
   for (const auto& e : expected) {
     ASSERT_TRUE(topics.count(e.topic)) << e.topic << "\n" << info.out;
     const YAML::Node& n = topics[e.topic];
@@ -149,7 +149,7 @@ TEST(SimulateBag, ScenariosChangeTopicsAndTruth) {
   EXPECT_EQ(t["bad_input"]["zero_k_camera_info_stamps_s"].size(), 1u);
   const YAML::Node y = YAML::Load(run("rosbag info --yaml " + bad).out);
   for (const YAML::Node& n : y["topics"]) {
-    if (n["topic"].as<std::string>() == "imu/data_raw") {
+    if (n["topic"].as<std::string>() == "/imu/data_raw") {
       EXPECT_EQ(n["messages"].as<long>(), t["counts"]["imu"].as<long>() + 5);  // 5 duplicates
     }
   }

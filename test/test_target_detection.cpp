@@ -5,7 +5,9 @@
 #include <yaml-cpp/yaml.h>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -359,6 +361,31 @@ TEST(RenderedTargets, NoTargetAndGarbageImagesAreNotDetections) {
   EXPECT_FALSE(detector.detect(cv::Mat(480, 640, CV_16UC1, cv::Scalar(0)), &obs));
   const TargetDetector aprilgrid(descriptionOf(scenario("aprilgrid")));
   EXPECT_FALSE(aprilgrid.detect(noise, &obs));
+}
+
+/// A target file one column short of the board (7x6 for the simulator's 8x6): not found, the
+/// sizes said, and fast. The classic detector's adaptive search (the old first step) took 3-4 s
+/// per frame to fail on such a frame on an idle machine (26 s on this loaded one, where this
+/// path took 0.44 s).
+TEST(RenderedTargets, AWrongBoardSizeFailsFastAndSaysTheSizes) {
+  const SimulationConfig c = scenario("nominal");
+  const auto views = renderHolds(c, 3);
+  const TargetDetector wrong(parseTargetYaml(
+      "target_type: checkerboard\ntargetCols: 7\ntargetRows: 6\nrowSpacingMeters: 0.04\n"
+      "colSpacingMeters: 0.04\n",
+      "wrong.yaml"));
+  for (const RenderedView& v : views) {
+    TargetObservation obs;
+    const auto start = std::chrono::steady_clock::now();
+    EXPECT_FALSE(wrong.detect(v.image, &obs));
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::printf("wrong board size: detection failed in %.3f s\n", seconds);
+    EXPECT_LT(seconds, 2.0);
+    EXPECT_NE(obs.mismatch.find("8 x 6 inner corners is in view"), std::string::npos)
+        << obs.mismatch;
+    EXPECT_NE(obs.mismatch.find("describes 7 x 6"), std::string::npos) << obs.mismatch;
+  }
 }
 
 TEST(RenderedTargets, PartialAprilGridWithFourTagsIsUsable) {

@@ -53,6 +53,7 @@ std::string AlignmentWrapper::Impl::imuFrame() const {
 }
 
 void AlignmentWrapper::Impl::onBroadcast(const BroadcastEstimate& estimate) {
+  noteReplacedBroadcast(estimate);
   // A refined estimate (within min_change_deg) keeps the tf: only the file changes.
   const bool refined = sent_R_cam_imu && sent_R_cam_imu->isApprox(estimate.R_cam_imu, 1e-12);
   if (refined) {
@@ -104,6 +105,7 @@ bool AlignmentWrapper::Impl::save(const BroadcastEstimate& estimate, std::string
   try {
     // The broadcast estimate with its own quality: the poses behind it, not the window's now.
     ResultMetadata meta{cameraFrame(), imuFrame(), estimate.poses};
+    backUpOutputOnce();
     writeResultYaml(settings.output_file, *estimate.result, meta);
     return true;
   } catch (const std::exception& e) {

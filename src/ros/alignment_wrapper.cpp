@@ -3,12 +3,14 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include <image_transport/camera_common.h>
 
 #include "alignment_wrapper_impl.h"
 #include "camera_imu_alignment/io/input_error.h"
 #include "camera_imu_alignment/ros/message_conversion.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/vision/target_description.h"
 
 namespace camera_imu_alignment {
@@ -23,7 +25,8 @@ AlignmentWrapper::Impl::Impl(ros::NodeHandle nh_, ros::NodeHandle private_nh)
       pnh(private_nh),
       name(private_nh.getNamespace()),
       transport(nh_),
-      diagnostics(nh_, private_nh) {
+      // Named after this instance: a nodelet's ros::this_node is its manager.
+      diagnostics(nh_, private_nh, private_nh.getNamespace()) {
   readSettings(pnh, &settings, &pipeline_settings);
   for (const std::string& notice : resolvePaths(&settings)) {
     ROS_WARN("%s: %s", name.c_str(), notice.c_str());
@@ -79,6 +82,12 @@ void AlignmentWrapper::Impl::subscribeCamera() {
         info_topic, 1, [this](const sensor_msgs::CameraInfoConstPtr&) {
           streams.seen(InputStream::kCameraInfo, ros::WallTime::now().toSec());
         });
+    // Images without their camera info never reach onImage: seen here (the message is shared
+    // with image_transport's subscription, not received twice).
+    image_watch_sub =
+        nh.subscribe<sensor_msgs::Image>(image_topic, 1, [this](const sensor_msgs::ImageConstPtr&) {
+          streams.seen(InputStream::kImage, ros::WallTime::now().toSec());
+        });
     return;
   }
   compressed_sub = nh.subscribe(image_topic + "/compressed", 30, &Impl::onCompressedImage, this);
@@ -105,6 +114,63 @@ std::string AlignmentWrapper::Impl::topicOf(InputStream stream) const {
   return toString(stream);
 }
 
+std::string AlignmentWrapper::Impl::cameraInputHint() const {
+  if (streams.everSeen(InputStream::kCameraPose)) return "";
+  const bool images = streams.everSeen(InputStream::kImage);
+  const bool info = streams.everSeen(InputStream::kCameraInfo);
+  if (info && !images) {
+    return "nothing on " + topicOf(InputStream::kImage) + " while camera info arrives on " +
+           topicOf(InputStream::kCameraInfo) + ": wrong image topic?";
+  }
+  if (images && !info) {
+    return "images arrive on " + topicOf(InputStream::kImage) + " but no camera info on " +
+           topicOf(InputStream::kCameraInfo) +
+           " (the image topic's sibling): frames are used only with their camera info";
+  }
+  if (!images && !info) {
+    return "nothing on " + topicOf(InputStream::kImage) + ", " + topicOf(InputStream::kCameraInfo) +
+           " or " + topicOf(InputStream::kCameraPose);
+  }
+  return "";
+}
+
+void AlignmentWrapper::Impl::noteReplacedBroadcast(const BroadcastEstimate& estimate) {
+  if (previous_broadcast && previous_broadcast->first.rfind("loaded", 0) == 0 &&
+      estimate.source == "estimated") {
+    const double apart_deg =
+        rad2deg(geodesicDistance(previous_broadcast->second, estimate.R_cam_imu));
+    const std::string text = "the new estimate replaces the calibration " +
+                             previous_broadcast->first + ", " + std::to_string(apart_deg) +
+                             " deg from it" +
+                             (settings.output_file.empty()
+                                  ? std::string()
+                                  : "; the old file is kept as " + settings.output_file + ".bak");
+    if (apart_deg > 1.0) {
+      ROS_WARN("%s: %s", name.c_str(), text.c_str());
+    } else {
+      ROS_INFO("%s: %s", name.c_str(), text.c_str());
+    }
+  }
+  previous_broadcast = std::make_pair(estimate.source, estimate.R_cam_imu);
+}
+
+void AlignmentWrapper::Impl::backUpOutputOnce() {
+  namespace fs = std::filesystem;
+  if (output_backed_up || settings.output_file.empty()) return;
+  std::error_code error;
+  if (!fs::exists(settings.output_file, error)) return;
+  output_backed_up = true;
+  const std::string backup = settings.output_file + ".bak";
+  fs::copy_file(settings.output_file, backup, fs::copy_options::overwrite_existing, error);
+  if (error) {
+    ROS_WARN("%s: could not keep the previous %s as %s (%s); it is overwritten", name.c_str(),
+             settings.output_file.c_str(), backup.c_str(), error.message().c_str());
+  } else {
+    ROS_INFO("%s: the previous %s is kept as %s", name.c_str(), settings.output_file.c_str(),
+             backup.c_str());
+  }
+}
+
 void AlignmentWrapper::Impl::checkStale() {
   warnSilentStreams();
   if (input_stopped || (ros::WallTime::now() - last_imu_wall).toSec() < 2.0) return;
@@ -128,6 +194,13 @@ void AlignmentWrapper::Impl::warnSilentStreams() {
     ros::WallTime& last = last_silent_warning[stream];
     if (!last.isZero() && (now - last).toSec() < 10.0) continue;
     last = now;
+    if (stream == InputStream::kCameraInfo && streams.everSeen(InputStream::kImage)) {
+      ROS_WARN(
+          "%s: nothing on %s for 5 s while images arrive on %s: frames are used only with their "
+          "camera info, published beside the image topic (the camera driver's camera_info)",
+          name.c_str(), topicOf(stream).c_str(), topicOf(InputStream::kImage).c_str());
+      continue;
+    }
     ROS_WARN(
         "%s: nothing on %s for 5 s while other inputs flow: wrong topic name (remap it), or "
         "the driver stopped",
@@ -213,6 +286,16 @@ void AlignmentWrapper::Impl::handleImage(const ImageMessage& image,
 void AlignmentWrapper::Impl::onCameraPose(const geometry_msgs::PoseStampedConstPtr& msg) {
   streams.seen(InputStream::kCameraPose, ros::WallTime::now().toSec());
   if (!input->checkStamp(msg->header, InputStream::kCameraPose)) return;
+  if (!camera_pose_frame_noted && settings.camera_frame.empty() && input->cameraFrame().empty()) {
+    // A PoseStamped names only its parent frame (the target's): the camera's tf frame is not in
+    // it, so the tf's camera end is a name chosen here, said once.
+    camera_pose_frame_noted = true;
+    ROS_INFO(
+        "%s: %s gives the camera in frame '%s' but names no camera frame: the tf's camera "
+        "frame is '%s' (set the camera_frame parameter to name it)",
+        name.c_str(), camera_pose_sub.getTopic().c_str(), msg->header.frame_id.c_str(),
+        cameraFrame().c_str());
+  }
   ++image_count;
   input->addCameraPose(*msg, calibrator->wantsFrames());
 }
@@ -225,9 +308,12 @@ void AlignmentWrapper::Impl::onPose(const StationaryPose& pose) {
 }
 
 void AlignmentWrapper::Impl::onPoseRejected(const RejectedPose& rejected) {
+  std::string reason = rejected.reason;
+  const std::string hint = cameraInputHint();
+  if (!hint.empty() && reason.rfind(kNoCameraDataReason, 0) == 0) reason += " (" + hint + ")";
   ROS_WARN_THROTTLE(2.0, "%s: rest %s-%s s not used: %s", name.c_str(),
                     formatStamp(rejected.start_s).c_str(), formatStamp(rejected.end_s).c_str(),
-                    rejected.reason.c_str());
+                    reason.c_str());
 }
 
 void AlignmentWrapper::Impl::onEstimate(const EstimateEvent& event) {

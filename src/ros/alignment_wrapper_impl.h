@@ -21,6 +21,8 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <string>
+#include <utility>
 
 #include "camera_imu_alignment/Calibrate.h"
 #include "camera_imu_alignment/online/online_calibrator.h"
@@ -55,9 +57,10 @@ struct AlignmentWrapper::Impl {
   // subscriptions to <image topic>/compressed and the sibling camera_info, whose latest message
   // goes with each image.
   ros::Subscriber compressed_sub, info_sub;
-  /// raw transport: camera info on its own as well, to tell a silent image topic from a silent
-  /// camera info topic (image_transport only calls back with both).
-  ros::Subscriber info_watch_sub;
+  /// raw transport: the image and camera info topics each on their own as well, to tell a silent
+  /// image topic from a silent camera info topic (image_transport only calls back with both).
+  ros::Subscriber info_watch_sub, image_watch_sub;
+  bool camera_pose_frame_noted = false;  ///< the camera frame camera_pose input uses was said
   sensor_msgs::CameraInfoConstPtr latest_info;
   std::unique_ptr<MessageInput> input;  ///< the checks and conversions calibrate_bag uses too
   ros::WallTime last_imu_wall;          ///< receipt time of the newest IMU message
@@ -88,6 +91,9 @@ struct AlignmentWrapper::Impl {
   void onCameraPose(const geometry_msgs::PoseStampedConstPtr& msg);
   /// The topic an input stream arrives on (resolved name), for messages.
   std::string topicOf(InputStream stream) const;
+  /// Which camera topic is silent while the other flows ("" when both or neither flow, or camera
+  /// poses come): appended to a rest's "no camera data" so that it names the topic to fix.
+  std::string cameraInputHint() const;
 
   // --- the calibrator's events
   void onPose(const StationaryPose& pose);
@@ -128,6 +134,14 @@ struct AlignmentWrapper::Impl {
   std::optional<Eigen::Matrix3d> sent_R_cam_imu;  ///< what the static tf says (none before)
   std::string save_error;  ///< why the last save failed ("" after a good one): diagnostics
   void loadSaved();
+  /// Called with every broadcast: says when an estimate replaces a calibration loaded from a file
+  /// (WARN when more than 1 deg apart), naming the file and the angle.
+  void noteReplacedBroadcast(const BroadcastEstimate& estimate);
+  std::optional<std::pair<std::string, Eigen::Matrix3d>> previous_broadcast;  ///< source, R
+  /// Before the first write of this run over an existing output_file: copies it to
+  /// `<output_file>.bak` (said at INFO; a failed copy is warned about and the save goes on).
+  void backUpOutputOnce();
+  bool output_backed_up = false;
   void publishStatus();
   void publishPoses();  ///< ~stationary_poses and ~target_pose
   std::string cameraFrame() const;

@@ -99,13 +99,43 @@ void readStaticTransforms(const rosbag::Bag& bag, tf2::BufferCore* tf) {
 
 }  // namespace
 
+bool readBagWindow(const CliArgs& args, BagRunInfo* info) {
+  if (!args.has("--start") && !args.has("--end")) return true;
+  const double duration_s = info->end_s - info->start_s;
+  double from_s = 0.0, to_s = duration_s;
+  try {
+    from_s = args.getDouble("--start", 0.0, 0.0, 1e9);
+    to_s = args.getDouble("--end", duration_s, 0.0, 1e9);
+  } catch (const UsageError& e) {
+    std::cerr << "calibrate_bag: " << e.what() << "\n";
+    return false;
+  }
+  if (from_s >= std::min(to_s, duration_s)) {
+    std::cerr << "calibrate_bag: --start " << from_s << " s to --end " << to_s
+              << " s holds nothing of the bag (" << duration_s << " s long)\n";
+    return false;
+  }
+  info->windowed = true;
+  const double begin_s = info->start_s;
+  info->start_s = begin_s + from_s;
+  info->end_s = begin_s + std::min(to_s, duration_s);
+  std::cerr << "[calibrate_bag] reading " << from_s << " s to " << info->end_s - begin_s
+            << " s of the bag (" << duration_s << " s)\n";
+  return true;
+}
+
 void readBag(const rosbag::Bag& bag, const BagTopics& topics, OnlineCalibrator* calibrator,
              BagProgress* progress, BagRunInfo* info) {
   std::vector<std::string> names = {topics.imu};
   for (const auto& t : {topics.mag, topics.image, topics.camera_info}) {
     if (!t.empty()) names.push_back(t);
   }
-  rosbag::View view(bag, rosbag::TopicQuery(names));
+  rosbag::View view;
+  if (info->windowed) {  // --start / --end
+    view.addQuery(bag, rosbag::TopicQuery(names), ros::Time(info->start_s), ros::Time(info->end_s));
+  } else {
+    view.addQuery(bag, rosbag::TopicQuery(names));
+  }
   // The nodelet's checks and conversions (MessageInput), so that both refuse the same messages.
   MessageInput input(calibrator, [](const std::string& notice) {
     std::cerr << "[calibrate_bag] note: " << notice << "\n";

@@ -12,6 +12,7 @@
 #include "bag_topics.h"
 #include "camera_imu_alignment/online/online_calibrator.h"
 #include "camera_imu_alignment/pipeline/input_rejections.h"
+#include "cli_args.h"
 
 namespace camera_imu_alignment {
 
@@ -49,7 +50,15 @@ struct BagRunInfo {
   std::string camera_frame, imu_frame;  ///< from the messages' headers ("" when none)
   std::uint64_t image_messages = 0, info_messages = 0;
   double start_s = 0.0, end_s = 0.0;  ///< the bag's time span (set by the caller)
+  /// --start / --end: only the messages in [start_s, end_s] (bag time, s) are read, start_s and
+  /// end_s narrowed to them.
+  bool windowed = false;
 };
+
+/// Applies calibrate_bag's --start / --end (seconds from the bag's first message) to `info`
+/// (start_s and end_s set to the bag's span). False after printing why on stderr (naming the
+/// option and the bag's duration) when a value is not a number or the window is empty.
+bool readBagWindow(const CliArgs& args, BagRunInfo* info);
 
 /// Feeds every message of the selected topics to `calibrator` in bag order, then finish()es it.
 /// Throws rosbag exceptions on a corrupt or truncated bag.

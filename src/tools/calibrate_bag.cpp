@@ -51,7 +51,7 @@ const char* kUsage =
     "                     [--imu-orientation joint|auto|magnetometer|message]\n"
     "                     [--output RESULT.yaml] [--imu-yaml IMU.yaml] [--report REPORT.png]\n"
     "                     [--truth TRUTH.yaml] [--export-poses POSES.csv]\n"
-    "                     [--check CURRENT.yaml] [--quiet]\n"
+    "                     [--check CURRENT.yaml] [--start S] [--end S] [--quiet]\n"
     "  --bag FILE.bag        ROS 1 bag: sensor_msgs/Imu, optional MagneticField, Image or\n"
     "                        CompressedImage and CameraInfo (topics found by type when not given)\n"
     "  --target TARGET.yaml  Kalibr target file (checkerboard, aprilgrid, circlegrid)\n"
@@ -76,6 +76,8 @@ const char* kUsage =
     "                        difference to the bag's joint estimate in degrees and sigmas and the\n"
     "                        chi-square test at consistency_level: exit 0 when consistent, 4 when\n"
     "                        not (nothing is written to --output / --imu-yaml)\n"
+    "  --start S, --end S    read only the part of the bag from S to S (seconds from its\n"
+    "                        first message; as rosbag play --start / --duration)\n"
     "  --quiet               no progress on stderr\n"
     "exit codes: 0 success, 2 bad input or usage, 3 not enough information (the message says what\n"
     "motion is missing), 4 an estimate that fails the quality gates or a mount that moved during\n"
@@ -170,6 +172,7 @@ int run(const cia::CliArgs& args) {
     rosbag::View all(bag);
     info.start_s = all.getBeginTime().toSec();
     info.end_s = all.getEndTime().toSec();
+    if (!cia::readBagWindow(args, &info)) return kExitBadInput;
   } catch (const std::exception& e) {
     std::cerr << "calibrate_bag: " << bag_path << ": " << e.what() << "\n";
     return kExitBadInput;
@@ -242,7 +245,7 @@ int run(const cia::CliArgs& args) {
   const bool gates_passed = outcome.verdict && outcome.verdict->passed;
   if (outcome.verdict) report.verdict = cia::ReportVerdict{gates_passed, outcome.verdict->text};
   std::cout << cia::formatSummary(report);
-  if (truth) {
+  if (truth && report.result.status != cia::SolveStatus::kBadInput) {  // else: no estimate
     std::cout << std::fixed << std::setprecision(4) << "error to " << args.get("--truth") << ": "
               << cia::rad2deg(cia::geodesicDistance(report.result.R_cam_imu, truth->R_cam_imu))
               << " deg\n";
@@ -268,6 +271,11 @@ int run(const cia::CliArgs& args) {
   const cia::SolveStatus status = report.result.status;
   if (status != cia::SolveStatus::kOk) {
     std::cerr << "calibrate_bag: " << report.result.message << "\n";
+    const std::string target_problem = snap.target_diagnosis;
+    if (!target_problem.empty()) {  // the target file, not the recording
+      std::cerr << "calibrate_bag: " << args.get("--target") << ": " << target_problem << "\n";
+      return kExitBadInput;
+    }
     return kExitNotEnoughInformation;  // the bag was read; it did not hold enough information
   }
   if (current) {
@@ -313,7 +321,7 @@ int main(int argc, char** argv) {
           argc, argv,
           {"--bag", "--target", "--config", "--imu-topic", "--mag-topic", "--image-topic",
            "--camera-info-topic", "--method", "--imu-orientation", "--output", "--imu-yaml",
-           "--report", "--truth", "--export-poses", "--check"},
+           "--report", "--truth", "--export-poses", "--check", "--start", "--end"},
           {"--help", "--quiet"});
     } catch (const cia::UsageError& e) {
       std::cerr << "calibrate_bag: " << e.what() << "\n" << kUsage;

@@ -239,7 +239,13 @@ int main(int argc, char** argv) {
       std::cout << usage();
       return 0;
     }
-    const cia::SimulateBagOptions options = cia::parseSimulateBagOptions(args);
+    cia::SimulateBagOptions options = cia::parseSimulateBagOptions(args);
+    // Bag topics are global names, as rosbag record writes them: `rosbag play --topics
+    // /camera/image_raw` matches only "/camera/image_raw", not "camera/image_raw".
+    for (std::string* topic : {&options.config.imu_topic, &options.config.mag_topic,
+                               &options.config.image_topic, &options.config.camera_info_topic}) {
+      if (!topic->empty() && (*topic)[0] != '/') *topic = "/" + *topic;
+    }
     const std::string& out = options.out;
     const BagOptions& bag_options = options.bag;
     const sim::SimulationConfig& config = options.config;

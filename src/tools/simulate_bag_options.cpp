@@ -302,7 +302,8 @@ const std::vector<Key>& simulateBagOptionTable() {
       number<double>("--motion-blur-s", CIA_MEMBER(config.motion_blur_exposure_s), within(0, 1),
                      "s", "> 0: frames in motion average renders over this exposure"),
       // ROS names, time base, bag.
-      textKey<Options>("--imu-topic", CIA_MEMBER(config.imu_topic), "a topic name", "IMU topic"),
+      textKey<Options>("--imu-topic", CIA_MEMBER(config.imu_topic), "a topic name",
+                       "IMU topic (a relative name is made global)"),
       textKey<Options>("--mag-topic", CIA_MEMBER(config.mag_topic), "a topic name",
                        "magnetometer topic"),
       textKey<Options>("--image-topic", CIA_MEMBER(config.image_topic), "a topic name",

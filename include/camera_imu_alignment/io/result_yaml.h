@@ -13,8 +13,8 @@
 namespace camera_imu_alignment {
 
 struct ResultMetadata {
-  std::string camera_frame = kDefaultCameraFrame;  ///< image header frame_id
-  std::string imu_frame = kDefaultImuFrame;        ///< Imu header frame_id
+  std::string camera_frame = kDefaultCameraFrame;  ///< the tf frame of the camera
+  std::string imu_frame = kDefaultImuFrame;        ///< the tf frame of the IMU
   int num_poses = 0;  ///< stationary poses behind the pairs (0: pairs given)
 };
 

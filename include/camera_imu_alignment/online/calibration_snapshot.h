@@ -98,6 +98,9 @@ struct CalibrationSnapshot {
   // --- inputs
   InputCounts inputs;
   RejectionCounts rejections;
+  /// "" unless the target was never found at rest (CalibrationPipeline::targetNotFoundDiagnosis):
+  /// what is wrong with the target file.
+  std::string target_diagnosis;
 
   // --- poses
   std::size_t rests_total = 0, poses_total = 0;  ///< since the start or the last reset

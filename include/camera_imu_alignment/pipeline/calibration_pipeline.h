@@ -8,8 +8,9 @@
 //   camera frames -> queued until the IMU shows whether the frame time is at rest; detection + PnP
 //     only on frames at rest (never while moving), at most max_frames_per_pose per pose
 //   segment end -> StationaryPose (camera: robust average of the frame orientations; IMU: see
-//     below) -> StationaryWindow -> on_pose. The pipeline does not solve: its owner (OnlineCalibrator)
-//     takes a snapshot() of the window and solves it with solveWindow, e.g. on a worker thread.
+//     below) -> StationaryWindow -> on_pose. The pipeline does not solve: its owner
+//     (OnlineCalibrator) takes a snapshot() of the window and solves it with solveWindow, e.g. on a
+//     worker thread.
 //
 // R_cam_imu (PipelineSettings::imu_orientation):
 //   kJoint (default): one maximum-likelihood estimate over the window's poses from every sensor
@@ -141,6 +142,9 @@ struct RejectedPose {
   double start_s = 0.0, end_s = 0.0;
   std::string reason;  ///< "target seen in 1 frame (2 needed)", "camera spread 0.8 deg", ...
 };
+/// The start of RejectedPose::reason when no camera frame (image or camera pose) reached the
+/// pipeline at all: the caller, who knows its topics, may say which one is silent.
+inline constexpr char kNoCameraDataReason[] = "no camera data";
 
 /// A copy of the window, to be solved away from the pipeline (solveWindow), e.g. on a worker
 /// thread while samples keep arriving.
@@ -222,6 +226,13 @@ class CalibrationPipeline : public SampleSink {
   std::uint64_t magneticSamples() const;
   std::uint64_t frames() const;
   std::uint64_t framesDetected() const;  ///< frames on which detection ran
+  /// Detection ran on at least this many frames before targetNotFoundDiagnosis() speaks.
+  static constexpr std::uint64_t kFramesForTargetDiagnosis = 3;
+  /// "" unless the target was never found in kFramesForTargetDiagnosis or more frames at rest;
+  /// then what is wrong: "the target (...) was not found in any of N frames at rest: does the
+  /// target file describe the board in view?", with the size of the board seen when the detector
+  /// found one of another size (TargetObservation::mismatch).
+  std::string targetNotFoundDiagnosis() const;
   bool hasIntrinsics() const;
   const PipelineSettings& settings() const;
 

@@ -18,6 +18,9 @@ namespace camera_imu_alignment {
 struct TargetObservation {
   std::vector<cv::Point2f> image_points;
   std::vector<int> point_ids;
+  /// Set when the target was not found but a board of another size was ("a checkerboard with 8 x
+  /// 6 inner corners is in view; the target file describes 7 x 6"); "" otherwise.
+  std::string mismatch;
 };
 
 struct DetectorSettings {
@@ -26,7 +29,9 @@ struct DetectorSettings {
 };
 
 /// Detects one target type in mono8 images. Checkerboard: cv::findChessboardCorners with a fast
-/// rejection (fallback findChessboardCornersSB for blurred or oblique views) + cornerSubPix,
+/// rejection, then findChessboardCornersSB (blurred or oblique views; allowed to find a larger
+/// board, so that a target file smaller than the board fails in well under a second and says so,
+/// where the classic detector's adaptive search took seconds per frame) + cornerSubPix,
 /// corners re-ordered so that index 0 is always the target origin (the 180-degree ambiguity is
 /// resolved by the square colours where the board allows it, otherwise by the orientation closest
 /// to `hint`); AprilGrid: tag36h11 via OpenCV aruco, Kalibr's layout, partial views allowed; circle

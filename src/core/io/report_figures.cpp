@@ -129,7 +129,9 @@ ReportFigures reportFigures(const ReportInput& in) {
     e.sigma_deg = in.result.quality.std_dev_deg;
     e.angle_deg = kNaN;
     e.error_deg = Eigen::Vector3d::Constant(kNaN);
-    if (finiteRotation(X) && finiteRotation(in.truth->R_cam_imu)) {
+    // Bad input: no estimate to compare (its rotation is a placeholder): the error is n/a.
+    if (in.result.status != SolveStatus::kBadInput && finiteRotation(X) &&
+        finiteRotation(in.truth->R_cam_imu)) {
       e.angle_deg = rad2deg(geodesicDistance(X, in.truth->R_cam_imu));
       e.error_deg = rad2deg(1.0) * logSO3(X * in.truth->R_cam_imu.transpose());
     }

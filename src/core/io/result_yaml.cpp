@@ -57,8 +57,8 @@ std::string resultToYaml(const AlignmentResult& r, const ResultMetadata& meta) {
   const SolutionQuality& q = r.quality;
   std::ostringstream out;
   out << std::setprecision(6);
-  out << "camera_frame: " << quoted(meta.camera_frame) << "  # image header frame_id\n";
-  out << "imu_frame: " << quoted(meta.imu_frame) << "  # Imu header frame_id\n";
+  out << "camera_frame: " << quoted(meta.camera_frame) << "  # the camera's tf frame\n";
+  out << "imu_frame: " << quoted(meta.imu_frame) << "  # the IMU's tf frame\n";
   writeRotation(out, "R_cam_imu", "p_cam = R_cam_imu * p_imu", R);
   out << "T_cam_imu:  # Kalibr camchain-imucam convention, translation zero\n";
   for (int i = 0; i < 3; ++i) {

@@ -454,6 +454,7 @@ CalibrationSnapshot OnlineCalibrator::snapshot() const {
   s.message = c.message;
   s.newest_stamp_s = c.clock.newest();
   s.inputs = inputCounts();
+  s.target_diagnosis = p.targetNotFoundDiagnosis();
   s.rejections = p.rejections();
   s.rests_total = p.restsTotal();
   s.poses_total = p.posesTotal();

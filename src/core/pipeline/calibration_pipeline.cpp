@@ -281,6 +281,10 @@ void CalibrationPipeline::Impl::processFrame(const CameraFrame& frame) {
     std::ostringstream out;
     out << "image at " << formatStamp(frame.stamp_s) << " s (at rest): " << target.describe()
         << " not found";
+    if (!observation.mismatch.empty()) {
+      target_mismatch = observation.mismatch;
+      out << " (" << observation.mismatch << ")";
+    }
     reject(RejectReason::kTargetNotFound, InputStream::kImage, out.str());
     return;
   }
@@ -292,6 +296,7 @@ void CalibrationPipeline::Impl::processFrame(const CameraFrame& frame) {
     return;
   }
   misses_in_a_row = 0;
+  target_mismatch.clear();  // the file's board is in view after all
   detections.push_back({frame.stamp_s, *pose});
 }
 
@@ -361,6 +366,19 @@ PipelineBufferSizes CalibrationPipeline::bufferSizes() const {
 std::uint64_t CalibrationPipeline::imuSamples() const { return impl_->num_imu; }
 std::uint64_t CalibrationPipeline::magneticSamples() const { return impl_->num_mag; }
 std::uint64_t CalibrationPipeline::frames() const { return impl_->num_frames; }
+
+std::string CalibrationPipeline::targetNotFoundDiagnosis() const {
+  const std::uint64_t tried = impl_->num_detected;
+  if (tried < kFramesForTargetDiagnosis ||
+      impl_->rejections.count(RejectReason::kTargetNotFound) < tried) {
+    return "";
+  }
+  std::string out = "the target (" + impl_->target.describe() + ") was not found in any of " +
+                    std::to_string(tried) +
+                    " frames at rest: does the target file describe the board in view?";
+  if (!impl_->target_mismatch.empty()) out += " " + impl_->target_mismatch;
+  return out;
+}
 std::uint64_t CalibrationPipeline::framesDetected() const { return impl_->num_detected; }
 bool CalibrationPipeline::hasIntrinsics() const { return impl_->intrinsics.has_value(); }
 const PipelineSettings& CalibrationPipeline::settings() const { return impl_->settings; }

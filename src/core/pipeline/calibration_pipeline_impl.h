@@ -57,6 +57,7 @@ struct CalibrationPipeline::Impl {
   std::optional<double> misses_rest;  ///< start of the rest they belong to
   std::uint64_t num_imu = 0, num_mag = 0, num_frames = 0, num_detected = 0;
   std::uint64_t frames_without_intrinsics = 0, frames_dropped = 0;
+  std::string target_mismatch;  ///< the detector's latest TargetObservation::mismatch
 
   // --- IMU orientation chain (see the rule in calibration_pipeline.h)
   bool chain_valid = false;
@@ -101,8 +102,8 @@ struct CalibrationPipeline::Impl {
   void acceptPose(const StationaryPose& pose, StationaryWindow::Entry joint_entry);
   /// The rest's measurements for the joint estimate (before the buffers move on); advances
   /// joint_gyro_pending by the gyro samples since the previous rest.
-  StationaryWindow::Entry jointMeasurements(const StationarySegment& segment, const StationaryPose& pose,
-                                       const SegmentField& field);
+  StationaryWindow::Entry jointMeasurements(const StationarySegment& segment,
+                                            const StationaryPose& pose, const SegmentField& field);
   WindowSnapshot snapshot() const;
 };
 

@@ -289,10 +289,17 @@ std::string CalibrationPipeline::Impl::assessCamera(const StationarySegment& seg
   detections.swap(later);
 
   if (static_cast<int>(rotations.size()) < settings.min_frames_per_pose) {
-    if (!intrinsics) return "no camera info received yet";
-    if (num_frames == 0) return "no camera data";
-    return "target seen in " + std::to_string(rotations.size()) + " frame(s), " +
-           std::to_string(settings.min_frames_per_pose) + " needed";
+    // Nothing arrived at all: the caller may name the silent topic (kNoCameraDataReason). Images
+    // that came without intrinsics are the camera info's fault.
+    if (num_frames == 0) return kNoCameraDataReason;
+    if (!intrinsics && frames_without_intrinsics > 0) {
+      return "no camera info received yet (" + std::to_string(frames_without_intrinsics) +
+             " image(s) waiting for it)";
+    }
+    std::string out = "target seen in " + std::to_string(rotations.size()) + " frame(s), " +
+                      std::to_string(settings.min_frames_per_pose) + " needed";
+    if (!target_mismatch.empty()) out += " (" + target_mismatch + ")";
+    return out;
   }
   const RotationAverage average = averageRotations(rotations, 4.0 * settings.max_camera_spread_deg);
   if (average.num_inliers < settings.min_frames_per_pose ||

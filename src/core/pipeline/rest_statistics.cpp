@@ -54,6 +54,9 @@ void appendGyroSamples(const std::deque<ImuSample>& samples, double from_s, doub
                        GyroSegment* segment) {
   for (const ImuSample& s : samples) {
     if (s.stamp_s < from_s || s.stamp_s > to_s) continue;
+    // Spans appended one after the other share their boundary sample ([a, b] then [b, c]), and
+    // a rest that became no pose is appended after the motion into it: each sample once.
+    if (!segment->stamps_s.empty() && s.stamp_s <= segment->stamps_s.back()) continue;
     segment->stamps_s.push_back(s.stamp_s);
     segment->gyro_rad_s.push_back(s.gyro_rad_s);
   }

@@ -24,7 +24,8 @@ struct RestStatistics {
 /// Statistics of the samples with stamps in [start_s, end_s] (count 0 when fewer than 2).
 RestStatistics restStatistics(const std::deque<ImuSample>& samples, double start_s, double end_s);
 
-/// Appends the raw gyro samples with stamps in [from_s, to_s] to `segment`.
+/// Appends the raw gyro samples with stamps in [from_s, to_s] later than `segment`'s last one (its
+/// stamps stay strictly increasing when spans sharing a boundary are appended in turn).
 void appendGyroSamples(const std::deque<ImuSample>& samples, double from_s, double to_s,
                        GyroSegment* segment);
 
