@@ -350,6 +350,11 @@ void AlignmentWrapper::Impl::diagnose(diagnostic_updater::DiagnosticStatusWrappe
                        std::to_string(snap.inputs.frames_detected) +
                        " frames at rest: does target_file describe the board in view?");
   }
+  if (snap.latest && snap.latest->result.joint && !snap.latest->result.joint->ok) {
+    problems.push_back(
+        "the joint estimate failed (" + snap.latest->result.joint->message + ")" +
+        (snap.broadcast ? "; the broadcast calibration is from an earlier window" : std::string()));
+  }
   if (!save_error.empty()) problems.push_back(save_error);
   std::string summary = std::string(toString(state)) + ": " + snap.message;
   for (const std::string& p : problems) {
