@@ -275,12 +275,14 @@ std::string CalibrationPipeline::Impl::assessCamera(const StationarySegment& seg
   // The frames inside the segment, margins off both ends; later ones are kept for the next rest.
   std::vector<Eigen::Matrix3d> rotations;
   double reprojection_sum = 0.0;
+  Eigen::Matrix3d pnp_cov_sum = Eigen::Matrix3d::Zero();
   const double lo = segment.start_s + settings.frame_margin_s;
   const double hi = segment.end_s - settings.frame_margin_s;
   for (const auto& d : detections) {
     if (d.stamp_s < lo || d.stamp_s > hi) continue;
     rotations.push_back(d.pose.R_target_cam);
     reprojection_sum += d.pose.reprojection_rms_px;
+    pnp_cov_sum += d.pose.cov_rotation_rad2;
     pose->p_target_cam = d.pose.p_target_cam;
   }
   std::vector<FrameDetection> later;
@@ -307,18 +309,22 @@ std::string CalibrationPipeline::Impl::assessCamera(const StationarySegment& seg
   pose->num_frames = average.num_inliers;
   pose->camera_spread_deg = average.spread_rms_deg;
   pose->reprojection_rms_px = reprojection_sum / static_cast<double>(rotations.size());
+  pose->camera_pnp_cov_rad2 = pnp_cov_sum / static_cast<double>(rotations.size());
   return "";
 }
 
 void CalibrationPipeline::Impl::acceptPose(const StationaryPose& pose,
                                            JointWindow::Entry joint_entry) {
   // The camera's covariance from the frames' scatter about their average (per axis, of the mean),
-  // with a floor for what the scatter cannot show (intrinsics, the target's flatness).
+  // with a floor for what the scatter cannot show (the target's flatness), plus what the
+  // reprojection residuals show (one frame's PnP covariance, the frames' mean, not divided by
+  // their number: the frames of a rest see the same lens, so an error of the camera model repeats
+  // in each of them; with pixel noise alone, as simulated, this term is well below the floor).
   const double spread_rad = deg2rad(pose.camera_spread_deg);
   const double variance = spread_rad * spread_rad / (3.0 * std::max(1, pose.num_frames)) +
                           std::pow(deg2rad(kCameraSigmaFloorDeg), 2);
   joint_entry.pose.R_target_cam = pose.R_target_cam;
-  joint_entry.pose.cov_cam_rad2 = variance * Eigen::Matrix3d::Identity();
+  joint_entry.pose.cov_cam_rad2 = variance * Eigen::Matrix3d::Identity() + pose.camera_pnp_cov_rad2;
   joint_entry.pose.group = pose.group;
   joint_window.add(std::move(joint_entry));
   joint_gyro_pending = GyroSegment{};  // the next motion starts at this rest
