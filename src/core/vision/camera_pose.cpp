@@ -49,7 +49,8 @@ double reprojectionRms(const std::vector<cv::Point3d>& object,
 
 /// sigma^2 (J^T J)^-1's rotation block for a pose (R_cam_target, t_cam_target) and its points:
 /// the pinhole projection's Jacobian with respect to a rotation Exp(e) R_cam_target (camera axes)
-/// and t, sigma^2 the squared reprojection residuals over 2N - 6. Zero when not determined.
+/// and t, sigma^2 the sum of the squared residual coordinates over 2N - 6. Zero when not
+/// determined.
 Eigen::Matrix3d rotationCovariance(const std::vector<cv::Point3d>& object, double reprojection_rms,
                                    const Eigen::Matrix3d& R_cam_target,
                                    const Eigen::Vector3d& t_cam_target,
@@ -72,8 +73,9 @@ Eigen::Matrix3d rotationCovariance(const std::vector<cv::Point3d>& object, doubl
     const Eigen::Matrix<double, 2, 6> J = d_uv_d_P * d_P;
     information += J.transpose() * J;
   }
-  const double sigma2 =
-      reprojection_rms * reprojection_rms * (2.0 * n) / std::max(1.0, 2.0 * n - 6.0);
+  // reprojection_rms^2 is the mean squared distance (both coordinates): per coordinate, its sum
+  // over the 2N - 6 degrees of freedom left.
+  const double sigma2 = reprojection_rms * reprojection_rms * n / std::max(1.0, 2.0 * n - 6.0);
   const Eigen::Matrix<double, 6, 6> covariance =
       sigma2 * information.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity());
   const Eigen::Matrix3d rotation = covariance.topLeftCorner<3, 3>();
