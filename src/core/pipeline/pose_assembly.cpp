@@ -316,15 +316,23 @@ std::string CalibrationPipeline::Impl::assessCamera(const StationarySegment& seg
 void CalibrationPipeline::Impl::acceptPose(const StationaryPose& pose,
                                            JointWindow::Entry joint_entry) {
   // The camera's covariance from the frames' scatter about their average (per axis, of the mean),
-  // with a floor for what the scatter cannot show (the target's flatness), plus what the
-  // reprojection residuals show (one frame's PnP covariance, the frames' mean, not divided by
-  // their number: the frames of a rest see the same lens, so an error of the camera model repeats
-  // in each of them; with pixel noise alone, as simulated, this term is well below the floor).
+  // with a floor for what the scatter cannot show (the target's flatness), plus the part of one
+  // frame's PnP covariance (from its reprojection residuals) beyond that scatter: residuals that
+  // the frames' scatter shows (pixel noise, as simulated) average out over the frames; the rest
+  // (the camera model's error: the frames of a rest see the same lens) repeats in every frame and
+  // is not divided by their number.
   const double spread_rad = deg2rad(pose.camera_spread_deg);
-  const double variance = spread_rad * spread_rad / (3.0 * std::max(1, pose.num_frames)) +
-                          std::pow(deg2rad(kCameraSigmaFloorDeg), 2);
+  const double frame_variance = spread_rad * spread_rad / 3.0;  // per axis, one frame
+  const double variance =
+      frame_variance / std::max(1, pose.num_frames) + std::pow(deg2rad(kCameraSigmaFloorDeg), 2);
+  Eigen::Matrix3d beyond_scatter = Eigen::Matrix3d::Zero();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> pnp(pose.camera_pnp_cov_rad2);
+  if (pnp.info() == Eigen::Success) {
+    const Eigen::Vector3d excess = (pnp.eigenvalues().array() - frame_variance).max(0.0).matrix();
+    beyond_scatter = pnp.eigenvectors() * excess.asDiagonal() * pnp.eigenvectors().transpose();
+  }
   joint_entry.pose.R_target_cam = pose.R_target_cam;
-  joint_entry.pose.cov_cam_rad2 = variance * Eigen::Matrix3d::Identity() + pose.camera_pnp_cov_rad2;
+  joint_entry.pose.cov_cam_rad2 = variance * Eigen::Matrix3d::Identity() + beyond_scatter;
   joint_entry.pose.group = pose.group;
   joint_window.add(std::move(joint_entry));
   joint_gyro_pending = GyroSegment{};  // the next motion starts at this rest
