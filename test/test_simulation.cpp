@@ -301,6 +301,41 @@ TEST(Simulation, TruthYamlIsReadableAndComplete) {
   std::remove(path.c_str());
 }
 
+// The wall-board session: 12 rests of 3-5 s, the optical axis within 35 deg of the board's normal
+// (plus the aim point's +-2 cm jitter, < 3 deg), the image's roll within 45 deg of the board's
+// rows, so that gravity spans a narrow cone in the camera (and IMU) frame.
+TEST(Simulation, WallBoardSessionKeepsTheViewNearTheNormalAndTheRollWithin45Deg) {
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    SimulationConfig c;
+    c.seed = seed;
+    ASSERT_TRUE(applyScenario("wall_board", &c));
+    ASSERT_EQ(validateConfig(c), "");
+    const Trajectory trajectory(c);
+    ASSERT_EQ(trajectory.poses().size(), 12u);
+    double largest_roll_deg = 0.0;
+    for (const StationaryPose& pose : trajectory.poses()) {
+      const double hold = pose.end_s - pose.start_s;
+      EXPECT_GE(hold, 3.0);
+      EXPECT_LE(hold, 5.0);
+      const Eigen::Matrix3d R_target_cam =
+          trajectory.R_world_target().transpose() * pose.R_world_cam;
+      const Eigen::Vector3d optical_axis = R_target_cam.col(2);
+      // The camera is on the board's +z side, looking back along -z.
+      const double view_deg = rad2deg(std::acos(std::min(1.0, -optical_axis.z())));
+      EXPECT_LT(view_deg, 38.0) << "seed " << seed;
+      // Roll: the image x axis against the board's x axis projected into the image plane.
+      const Eigen::Vector3d board_x = Eigen::Vector3d::UnitX();
+      const Eigen::Vector3d x0 = (board_x - board_x.dot(optical_axis) * optical_axis).normalized();
+      const Eigen::Vector3d y0 = optical_axis.cross(x0);
+      const double roll_deg =
+          rad2deg(std::atan2(R_target_cam.col(0).dot(y0), R_target_cam.col(0).dot(x0)));
+      EXPECT_LE(std::abs(roll_deg), 45.0 + 1e-9) << "seed " << seed;
+      largest_roll_deg = std::max(largest_roll_deg, std::abs(roll_deg));
+    }
+    EXPECT_GT(largest_roll_deg, 25.0) << "seed " << seed << ": the roll range is used";
+  }
+}
+
 TEST(Simulation, ScenariosAreAllValid) {
   for (const auto& s : scenarioList()) {
     SimulationConfig c;

@@ -31,7 +31,7 @@ TEST(SimulateBag, HelpListsEveryScenario) {
   const RunResult r = run(kSim + " --help");
   EXPECT_EQ(r.exit_code, 0);
   for (const char* s :
-       {"nominal", "aprilgrid", "circlegrid", "noisy_imu", "few_poses", "degenerate",
+       {"nominal", "wall_board", "aprilgrid", "circlegrid", "noisy_imu", "few_poses", "degenerate",
         "no_magnetometer", "magnetic_disturbance", "time_offset", "remount", "bad_input",
         "long_run", "tactical", "consumer", "noisy_consumer"}) {
     EXPECT_NE(r.out.find(s), std::string::npos) << s;

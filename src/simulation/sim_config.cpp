@@ -11,6 +11,9 @@ namespace simulation {
 const std::vector<std::pair<std::string, std::string>>& scenarioList() {
   static const std::vector<std::pair<std::string, std::string>> list = {
       {"nominal", "checkerboard, 12 poses, all axes excited, realistic MEMS noise"},
+      {"wall_board",
+       "hand-held in front of a board on a wall: 12 rests of 3-5 s, view within 35 deg of the "
+       "board's normal, roll within 45 deg (gravity spans a narrow cone; any --imu-grade)"},
       {"aprilgrid", "nominal with a Kalibr AprilGrid (tag36h11) target"},
       {"circlegrid", "nominal with a symmetric circle grid target"},
       {"noisy_imu", "nominal with every sensor noise x5"},
@@ -41,6 +44,14 @@ bool applyScenario(const std::string& name, SimulationConfig* config) {
   config->scenario = name;
   SimulationConfig& c = *config;
   if (name == "nominal") {
+  } else if (name == "wall_board") {
+    // The way people hold a rig in front of a wall board: the camera within 35 deg of the
+    // board's normal (the default tilt), the image's roll within +-45 deg.
+    c.num_poses = 12;
+    c.hold_min_s = 3.0;
+    c.hold_max_s = 5.0;
+    c.max_tilt_deg = 35.0;
+    c.max_roll_deg = 45.0;
   } else if (name == "aprilgrid") {
     c.target.type = TargetType::kAprilgrid;
     c.target.cols = 4;

@@ -87,7 +87,7 @@ struct ImuModelPriors {
 
 enum class RobustLossKind { kNone, kHuber, kCauchy };
 enum class MagnetometerUse {
-  kAuto,  ///< use it when its hard iron is excited (see JointSettings)
+  kAuto,  ///< use it when enough poses have a usable field (JointSettings::min_mag_poses_hard_iron)
   kOn,    ///< use every usable pose's field, even with the iron held at its prior
   kOff
 };
@@ -130,28 +130,18 @@ struct JointSettings {
   /// about that pose's gravity is determined by nothing but a weak prior).
   bool compute_covariance = true;
 
-  // Observability: what the poses do not excite is not estimated (estimated = false, a note). By
-  // default such a parameter keeps its prior as a constraint (it stays at its prior mean unless the
-  // data say otherwise, and its prior uncertainty is carried into every covariance, so the 1-sigma
-  // of R_cam_imu still covers it); with pin_unexcited_parameters it is held constant at the prior
-  // mean (SetParameterBlockConstant), and the covariances ignore its uncertainty.
+  // What the data determine. Every parameter is estimated with its prior: no geometric rule (of
+  // rotation angles, gravity or field directions) decides what is estimated. A parameter the poses
+  // carry little information about (posterior 1-sigma above kInformedFraction of its prior's on
+  // some entry, joint_observability.h) stays near its prior mean, its prior uncertainty carried
+  // into every covariance so that the 1-sigma of R_cam_imu still covers it; it is reported as not
+  // estimated, with a note. With pin_unexcited_parameters such a parameter is instead held
+  // constant at its prior mean (SetParameterBlockConstant; decided by a first solve) and the
+  // covariances ignore its uncertainty.
   bool pin_unexcited_parameters = false;
-  /// A gyro axis' column of T_g (its scale and cross-axis terms) is estimated when the accumulated
-  /// |rotation| about that IMU axis over all motions exceeds this (deg).
-  double min_gyro_axis_rotation_deg = 30.0;
-  /// Coverage of unit directions u_k: sqrt of the smallest eigenvalue of mean(u u^T) (0: all
-  /// along one line, 0.58: spread evenly over the sphere). Spread: the same about their mean
-  /// (sqrt of the smallest eigenvalue of their covariance; 0 for fewer than 4 poses, which lie in
-  /// a plane). The accelerometer bias needs the gravity directions' coverage, T_a - I their spread
-  /// (an affine map needs 4 non-coplanar directions). Defaults: ~9 and ~6 deg of tilt.
-  double min_gravity_coverage_bias = 0.15;
-  double min_gravity_spread_matrix = 0.1;
-  /// Hard iron: at least this many poses with a usable field and its coverage; soft iron: its
-  /// spread (like the accelerometer's bias and matrix).
+  /// MagnetometerUse::kAuto uses the magnetometer when at least this many poses have a usable
+  /// field (the hard iron, 3 unknowns, then has more field directions than unknowns).
   int min_mag_poses_hard_iron = 4;
-  double min_mag_coverage_hard_iron = 0.1;
-  int min_mag_poses_soft_iron = 7;
-  double min_mag_spread_soft_iron = 0.1;
 
   // Noise floors (added in quadrature to the given covariances; 1-sigma).
   double accel_mean_sigma_floor_m_s2 = 5e-4;

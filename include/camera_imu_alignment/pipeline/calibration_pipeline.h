@@ -125,6 +125,9 @@ struct StationaryPose {
   int num_frames = 0;
   double camera_spread_deg = 0.0;    ///< RMS of frame orientations about the average
   double reprojection_rms_px = 0.0;  ///< mean over the frames used
+  /// Mean over the frames of their PnP orientation covariance (CameraPose::cov_rotation_rad2;
+  /// rad^2, camera axes): the reprojection residuals beyond what the frames' scatter shows.
+  Eigen::Matrix3d camera_pnp_cov_rad2 = Eigen::Matrix3d::Zero();
   // IMU.
   Eigen::Matrix3d R_world_imu = Eigen::Matrix3d::Identity();  ///< used for the pairs
   PoseImuSource imu_source = PoseImuSource::kGyro;            ///< where R_world_imu came from

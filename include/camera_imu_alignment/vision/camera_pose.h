@@ -29,6 +29,12 @@ struct CameraPose {
   double reprojection_mean_px = 0.0;  ///< mean reprojection distance (px)
   double ambiguity_ratio = 0.0;  ///< second-best / best reprojection RMS of the planar solutions
   int num_points = 0;
+  /// Covariance of R_target_cam (rad^2, camera axes, right perturbation R Exp(delta)) that the
+  /// reprojection residuals imply: sigma^2 (J^T J)^-1 of the pinhole PnP, sigma^2 the sum of the
+  /// squared residual coordinates over 2N - 6. What the image says about this frame's orientation,
+  /// errors of the camera model included (a lens distortion missing from camera_info shows here,
+  /// not in the scatter of the frames of one rest, which see the same lens).
+  Eigen::Matrix3d cov_rotation_rad2 = Eigen::Matrix3d::Zero();
 };
 
 /// PnP (IPPE on undistorted points, then Levenberg-Marquardt refinement). Returns nullopt with the

@@ -90,9 +90,26 @@ std::string summary(const JointProblem& problem, const JointResult& result) {
   return buffer;
 }
 
-/// One solve with the matrices' model of `settings` (kEstimate or kIdentity).
+/// What a solve with every parameter estimated found undetermined, as the parameters to hold
+/// (pin_unexcited_parameters).
+JointObservability heldByInformation(JointObservability observability, const JointResult& free) {
+  const ImuIntrinsics& in = free.intrinsics;
+  for (int c = 0; c < 3; ++c) {
+    observability.gyro_column_estimated[c] =
+        observability.gyro_column_estimated[c] && in.gyro_matrix_column_estimated[c];
+  }
+  observability.accel_matrix_estimated = in.accel_matrix_estimated;
+  observability.accel_bias_estimated = in.accel_bias_estimated;
+  observability.hard_iron_estimated = in.hard_iron_estimated;
+  observability.soft_iron_estimated = in.soft_iron_estimated;
+  return observability;
+}
+
+/// One solve with the matrices' model of `settings` (kEstimate or kIdentity). With
+/// pin_unexcited_parameters: a first solve with every parameter free finds what the data do not
+/// determine (`held` null), a second one holds it (`held`: what to estimate).
 JointResult solveModel(const JointProblem& problem, const Eigen::Matrix3d& R_cam_imu_initial,
-                       const JointSettings& settings) {
+                       const JointSettings& settings, const JointObservability* held = nullptr) {
   const auto start = std::chrono::steady_clock::now();
   JointResult result;
   const auto finish = [&](JointResult& r) -> JointResult {
@@ -108,18 +125,28 @@ JointResult solveModel(const JointProblem& problem, const Eigen::Matrix3d& R_cam
   result.message = joint::validateProblem(problem, R_cam_imu_initial, settings);
   if (!result.message.empty()) return finish(result);
 
-  // Preintegrate with the ideal gyro and the rests' biases; decide what the motion excites.
+  // Preintegrate with the ideal gyro and the rests' biases.
   const size_t n = problem.poses.size();
   std::vector<Eigen::Vector3d> biases(n);
   for (size_t k = 0; k < n; ++k) biases[k] = problem.poses[k].gyro_mean_rad_s;
   std::vector<GyroPreintegration> gyro =
       preintegrateAll(problem, Eigen::Matrix3d::Identity(), biases);
-  // The gyro's excitation is judged again after the first pass, from the gyro corrected by the
-  // estimated T_g (the raw gyro's cross-axis terms leak ~1 % of every rotation into other axes);
-  // until then no gyro column is pinned.
-  JointObservability observability = decideObservability(problem, excitationOf(gyro), settings);
-  observability.gyro_column_estimated = {true, true, true};
+  if (settings.pin_unexcited_parameters && held == nullptr) {
+    JointSettings free_settings = settings;
+    free_settings.pin_unexcited_parameters = false;
+    const JointResult free = solveModel(problem, R_cam_imu_initial, free_settings);
+    if (!free.ok) return free;
+    const JointObservability hold =
+        heldByInformation(decideObservability(problem, excitationOf(gyro), settings), free);
+    JointResult pinned = solveModel(problem, free.R_cam_imu, settings, &hold);
+    pinned.solve_time_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return pinned;
+  }
+  JointObservability observability =
+      held ? *held : decideObservability(problem, excitationOf(gyro), settings);
   joint::State state = joint::initialState(problem, R_cam_imu_initial, observability, settings);
+  if (held) state.holdUnexcitedGyroColumns(observability);
   joint::Whitening whitening;
   if (!joint::computeWhitening(problem, gyro, settings, &whitening, &result.message)) {
     return finish(result);
@@ -136,10 +163,6 @@ JointResult solveModel(const JointProblem& problem, const Eigen::Matrix3d& R_cam
       }
       for (size_t k = 0; k < n; ++k) biases[k] = state.gyroBias(static_cast<int>(k));
       gyro = preintegrateAll(problem, T_g, biases);
-      if (pass == 1) {
-        observability = decideObservability(problem, excitationOf(gyro), settings);
-        if (settings.pin_unexcited_parameters) state.holdUnexcitedGyroColumns(observability);
-      }
     }
     ceres::Problem ceres_problem;
     const joint::BuiltProblem built = joint::buildProblem(problem, gyro, whitening, observability,
@@ -153,7 +176,7 @@ JointResult solveModel(const JointProblem& problem, const Eigen::Matrix3d& R_cam
       return finish(result);
     }
     converged = solver_summary.termination_type == ceres::CONVERGENCE;
-    // With gyro segments at least two passes: the second one judges the gyro's excitation.
+    // With gyro segments at least two passes: the first is linearised about the ideal gyro.
     const bool judged = problem.segments.empty() || pass >= 1;
     gyro_settled = gyroModelChange(problem, state, gyro) < kRelinearisationThreshold;
     const bool last = pass + 1 == settings.max_relinearisations || (judged && gyro_settled);
@@ -175,8 +198,9 @@ JointResult solveModel(const JointProblem& problem, const Eigen::Matrix3d& R_cam
     result.message = "the estimate is not finite";
     return finish(result);
   }
-  result.suggested_rotation_axis_imu = observability.suggested_rotation_axis_imu;
   result.notes = observability.notes;
+  result.imu_matrices = settings.imu_matrices;
+  describeInformation(observability, settings, &result);
   if (!(result.std_dev_deg.maxCoeff() <= settings.undetermined_std_dev_deg)) {
     char buffer[256];
     std::snprintf(buffer, sizeof(buffer),
@@ -348,11 +372,8 @@ JointResult screenMagnetometer(const JointProblem& problem,
   if (flagged == 0 || settings.use_magnetometer == MagnetometerUse::kOff) {
     return solveMatrices(unflagged, R_cam_imu_initial, settings);
   }
-  // The raw field's directions understate how much the orientations vary (a hard iron of the
-  // earth field's size pulls them together), so the coverage rule is not applied here: the hard
-  // iron is estimated, and counts as calibrated when the data, not its prior, determine it.
-  JointSettings screen_settings = settings;
-  screen_settings.min_mag_coverage_hard_iron = 0.0;
+  // The hard iron counts as calibrated when the data, not its prior, determine it.
+  const JointSettings& screen_settings = settings;
   JointProblem screened = problem;
   std::vector<int> left_out;
   for (int round = 0; round <= static_cast<int>(problem.poses.size()) / 2; ++round) {

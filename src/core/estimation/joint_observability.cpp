@@ -1,9 +1,11 @@
 #include "camera_imu_alignment/estimation/joint_observability.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
+#include "camera_imu_alignment/results/joint_result.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {
@@ -65,34 +67,29 @@ double directionSpread(const std::vector<Eigen::Vector3d>& unit_directions,
   return std::sqrt(std::max(0.0, solver.eigenvalues()(0)));
 }
 
+bool informedByTheData(const Eigen::VectorXd& posterior_sigma, const Eigen::VectorXd& prior_sigma) {
+  if (posterior_sigma.size() == 0 || posterior_sigma.size() != prior_sigma.size()) return false;
+  for (int i = 0; i < posterior_sigma.size(); ++i) {
+    if (!(prior_sigma(i) > 0.0)) continue;
+    if (!(posterior_sigma(i) <= kInformedFraction * prior_sigma(i))) return false;
+  }
+  return true;
+}
+
 JointObservability decideObservability(const JointProblem& problem, const GyroExcitation& gyro,
                                        const JointSettings& settings) {
   JointObservability out;
-  const std::string held = settings.pin_unexcited_parameters
-                               ? "held at its prior"
-                               : "held at its prior (with its prior uncertainty)";
-
-  // Gyro: column j of T_g multiplies the rate about IMU axis j.
   out.gyro_axis_rotation_deg = gyro.accumulated_abs_angle_rad * (180.0 / kPi);
   if (!gyro.has_segments) {
     out.notes.push_back(
         "no gyro segments: the gyro model is not estimated (accelerometer, magnetometer and camera "
         "only)");
-  } else {
-    for (int axis = 0; axis < 3; ++axis) {
-      out.gyro_column_estimated[axis] =
-          out.gyro_axis_rotation_deg(axis) >= settings.min_gyro_axis_rotation_deg;
-      if (!out.gyro_column_estimated[axis]) {
-        const std::string name = kAxisNames[axis];
-        out.notes.push_back("gyro scale " + name + " and its cross-axis terms " + held + ": " +
-                            format("%.1f", out.gyro_axis_rotation_deg(axis), 0) +
-                            " deg accumulated about IMU " + name + "; rotate about IMU " + name +
-                            format(" by %.0f deg or more", settings.min_gyro_axis_rotation_deg, 0));
-      }
-    }
   }
+  out.gyro_column_estimated = {gyro.has_segments, gyro.has_segments, gyro.has_segments};
+  out.accel_bias_estimated = true;
+  out.accel_matrix_estimated = true;
 
-  // Accelerometer: gravity seen in several directions.
+  // The geometry, for the notes and the suggestion only.
   std::vector<Eigen::Vector3d> gravity_directions;
   Eigen::Vector3d mean_gravity = Eigen::Vector3d::Zero();
   for (const JointPose& pose : problem.poses) {
@@ -102,24 +99,7 @@ JointObservability decideObservability(const JointProblem& problem, const GyroEx
   mean_gravity = mean_gravity.norm() > 1e-9 ? mean_gravity.normalized() : Eigen::Vector3d::UnitZ();
   out.gravity_coverage = directionCoverage(gravity_directions);
   out.gravity_spread = directionSpread(gravity_directions);
-  out.accel_bias_estimated = out.gravity_coverage >= settings.min_gravity_coverage_bias;
-  out.accel_matrix_estimated = out.gravity_spread >= settings.min_gravity_spread_matrix;
-  if (!out.accel_bias_estimated) {
-    out.notes.push_back("accelerometer bias " + held +
-                        format(": gravity direction coverage %.3f < %.3f", out.gravity_coverage,
-                               settings.min_gravity_coverage_bias) +
-                        "; tilt the rig much further between poses (on its sides, upside down)");
-  }
-  if (!out.accel_matrix_estimated) {
-    out.notes.push_back("accelerometer scale and non-orthogonality " + held +
-                        format(": gravity direction spread %.3f < %.3f", out.gravity_spread,
-                               settings.min_gravity_spread_matrix) +
-                        " (needs 4 or more poses whose gravity directions are not in one plane); "
-                        "show gravity along "
-                        "each IMU axis, both ways");
-  }
 
-  // Magnetometer: enough distinct orientations with a usable field.
   std::vector<Eigen::Vector3d> mag_directions;
   for (const JointPose& pose : problem.poses) {
     if (pose.mag_mean_t) mag_directions.push_back(pose.mag_mean_t->normalized());
@@ -127,10 +107,6 @@ JointObservability decideObservability(const JointProblem& problem, const GyroEx
   out.usable_mag_poses = static_cast<int>(mag_directions.size());
   out.mag_coverage = directionCoverage(mag_directions);
   out.mag_spread = directionSpread(mag_directions);
-  const bool hard_iron_excited = out.usable_mag_poses >= settings.min_mag_poses_hard_iron &&
-                                 out.mag_coverage >= settings.min_mag_coverage_hard_iron;
-  const bool soft_iron_excited = out.usable_mag_poses >= settings.min_mag_poses_soft_iron &&
-                                 out.mag_spread >= settings.min_mag_spread_soft_iron;
   switch (settings.use_magnetometer) {
     case MagnetometerUse::kOff:
       out.magnetometer_used = false;
@@ -140,65 +116,114 @@ JointObservability decideObservability(const JointProblem& problem, const GyroEx
       out.magnetometer_used = out.usable_mag_poses > 0;
       break;
     case MagnetometerUse::kAuto:
-      out.magnetometer_used = hard_iron_excited;
-      if (out.usable_mag_poses > 0 && !hard_iron_excited) {
+      out.magnetometer_used = out.usable_mag_poses >= settings.min_mag_poses_hard_iron;
+      if (out.usable_mag_poses > 0 && !out.magnetometer_used) {
         out.notes.push_back(
-            format("magnetometer not used: its hard iron is not excited (%.0f usable poses, "
-                   "coverage %.3f; ",
-                   out.usable_mag_poses, out.mag_coverage) +
-            format("needs %.0f and %.2f)", settings.min_mag_poses_hard_iron,
-                   settings.min_mag_coverage_hard_iron));
+            format("magnetometer not used: %.0f pose(s) with a usable field, ",
+                   out.usable_mag_poses, 0) +
+            format("fewer than the %.0f its hard iron needs (min_mag_poses_hard_iron)",
+                   settings.min_mag_poses_hard_iron, 0));
       }
       break;
   }
-  if (out.magnetometer_used) {
-    out.hard_iron_estimated = hard_iron_excited;
-    out.soft_iron_estimated = soft_iron_excited;
-    if (!hard_iron_excited) {
-      out.notes.push_back("magnetometer hard iron " + held +
-                          " (magnetometer forced on with too few or too similar orientations)");
-    }
-    if (!soft_iron_excited) {
-      out.notes.push_back(
-          "magnetometer soft iron " + held +
-          format(": %.0f usable poses, spread %.3f", out.usable_mag_poses, out.mag_spread) +
-          format(" (needs %.0f and %.2f); more distinct orientations with a usable "
-                 "field",
-                 settings.min_mag_poses_soft_iron, settings.min_mag_spread_soft_iron));
-    }
-  }
+  out.hard_iron_estimated = out.magnetometer_used;
+  out.soft_iron_estimated = out.magnetometer_used;
 
-  // The rotation axis that would add the most: the least-excited gyro axis when a column is held,
-  // else (accelerometer held) one perpendicular to the mean gravity direction, else the least
-  // excited axis overall.
-  Eigen::Vector3d least_excited = perpendicularAxis(mean_gravity, gyro);
+  out.perpendicular_to_gravity_imu = perpendicularAxis(mean_gravity, gyro);
+  out.least_excited_axis_imu = out.perpendicular_to_gravity_imu;
   if (gyro.has_segments) {
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(gyro.excitation_rad);
-    if (solver.info() == Eigen::Success) least_excited = solver.eigenvectors().col(0).normalized();
+    if (solver.info() == Eigen::Success) {
+      out.least_excited_axis_imu = solver.eigenvectors().col(0).normalized();
+    }
   }
-  const bool gyro_held =
-      gyro.has_segments && !(out.gyro_column_estimated[0] && out.gyro_column_estimated[1] &&
-                             out.gyro_column_estimated[2]);
-  const bool accel_held = !out.accel_bias_estimated || !out.accel_matrix_estimated;
-  if (!gyro_held && accel_held) {
-    out.suggested_rotation_axis_imu = perpendicularAxis(mean_gravity, gyro);
-  } else {
-    out.suggested_rotation_axis_imu = least_excited;
+  for (Eigen::Vector3d* axis : {&out.least_excited_axis_imu, &out.perpendicular_to_gravity_imu}) {
+    if (!axis->allFinite() || axis->norm() < 0.5) *axis = Eigen::Vector3d::UnitX();
   }
-  if (!out.suggested_rotation_axis_imu.allFinite() ||
-      out.suggested_rotation_axis_imu.norm() < 0.5) {
-    out.suggested_rotation_axis_imu = Eigen::Vector3d::UnitX();
+  out.suggested_rotation_axis_imu = out.least_excited_axis_imu;
+  return out;
+}
+
+namespace {
+
+/// Largest posterior/prior 1-sigma ratio over the entries (the prior's share of the estimate).
+double largestShare(const Eigen::VectorXd& posterior_sigma, const Eigen::VectorXd& prior_sigma) {
+  double share = 0.0;
+  for (int i = 0; i < posterior_sigma.size() && i < prior_sigma.size(); ++i) {
+    if (prior_sigma(i) > 0.0) share = std::max(share, posterior_sigma(i) / prior_sigma(i));
   }
-  if (gyro_held || accel_held) {
-    const Eigen::Vector3d& a = out.suggested_rotation_axis_imu;
+  return share;
+}
+
+Eigen::VectorXd flat(const Eigen::Matrix3d& m) {
+  return Eigen::Map<const Eigen::VectorXd>(m.data(), 9);
+}
+
+}  // namespace
+
+void describeInformation(const JointObservability& observability, const JointSettings& settings,
+                         JointResult* result) {
+  const ImuIntrinsics& in = result->intrinsics;
+  const ImuModelPriors& p = settings.priors;
+  const bool identity = result->imu_matrices == ImuMatrixModel::kIdentity;
+  const double unscale = 1.0 / std::sqrt(std::max(1.0, result->covariance_scale));
+  const std::string rests = settings.pin_unexcited_parameters
+                                ? "held at its prior mean (pin_unexcited_parameters)"
+                                : "rests on its prior (its prior uncertainty is in R_cam_imu's "
+                                  "1-sigma)";
+  auto note = [&](const std::string& what, double share) {
+    result->notes.push_back(
+        what + " " + rests +
+        format(": the poses carry little information about it (posterior 1-sigma up to %.0f %% "
+               "of the prior's)",
+               100.0 * share, 0));
+  };
+  bool gyro_undetermined = false, accel_undetermined = false;
+  if (!identity && observability.gyro_column_estimated[0]) {
+    for (int c = 0; c < 3; ++c) {
+      if (in.gyro_matrix_column_estimated[c]) continue;
+      gyro_undetermined = true;
+      const Eigen::Vector3d prior = Eigen::Vector3d::Constant(p.gyro_cross_axis) +
+                                    Eigen::Vector3d::Unit(c) * (p.gyro_scale - p.gyro_cross_axis);
+      const std::string name = kAxisNames[c];
+      note("gyro scale " + name + " and its cross-axis terms",
+           largestShare(in.gyro_matrix_sigma.col(c) * unscale, prior));
+    }
+  }
+  if (!identity && !in.accel_matrix_estimated) {
+    accel_undetermined = true;
+    note("accelerometer scale and non-orthogonality",
+         largestShare(flat(in.accel_matrix_sigma) * unscale,
+                      flat(Eigen::Matrix3d::Constant(p.accel_cross_axis) +
+                           Eigen::Matrix3d::Identity() * (p.accel_scale - p.accel_cross_axis))));
+  }
+  if (!in.accel_bias_estimated) {
+    accel_undetermined = true;
+    note("accelerometer bias", largestShare(in.accel_bias_sigma_m_s2 * unscale,
+                                            Eigen::Vector3d::Constant(p.accel_bias_m_s2)));
+  }
+  if (in.magnetometer_used && !in.hard_iron_estimated) {
+    note("magnetometer hard iron",
+         largestShare(in.hard_iron_sigma_t * unscale, Eigen::Vector3d::Constant(p.hard_iron_t)));
+  }
+  if (in.magnetometer_used && !in.soft_iron_estimated) {
+    note("magnetometer soft iron",
+         largestShare(flat(in.soft_iron_sigma) * unscale,
+                      flat(Eigen::Matrix3d::Constant(p.soft_iron_cross) +
+                           Eigen::Matrix3d::Identity() * (p.soft_iron_scale - p.soft_iron_cross))));
+  }
+  const Eigen::Vector3d& axis = !gyro_undetermined && accel_undetermined
+                                    ? observability.perpendicular_to_gravity_imu
+                                    : observability.least_excited_axis_imu;
+  result->suggested_rotation_axis_imu = axis;
+  if (gyro_undetermined || accel_undetermined) {
     char buffer[160];
     std::snprintf(
         buffer, sizeof(buffer),
-        "next, rotate about the IMU axis (%.2f, %.2f, %.2f) (suggested_rotation_axis_imu)", a.x(),
-        a.y(), a.z());
-    out.notes.push_back(buffer);
+        "next, rotate about the IMU axis (%.2f, %.2f, %.2f) (suggested_rotation_axis_imu)",
+        axis.x(), axis.y(), axis.z());
+    result->notes.push_back(buffer);
   }
-  return out;
 }
 
 }  // namespace camera_imu_alignment

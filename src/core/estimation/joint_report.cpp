@@ -167,7 +167,10 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
   in.accel_matrix =
       Eigen::Matrix3d::Identity() + sixToMatrix(toVector(state.accel_matrix.data(), 6), symmetric);
   in.accel_matrix_sigma = sixToMatrix(accel_sigma, symmetric);
-  in.accel_matrix_estimated = observability.accel_matrix_estimated && !identity;
+  // Estimated = determined by the data (joint_observability.h), judged on the unscaled 1-sigma.
+  const double unscale = 1.0 / std::sqrt(scale);
+  in.accel_matrix_estimated = observability.accel_matrix_estimated && !identity &&
+                              informedByTheData(accel_sigma * unscale, accel_prior);
   const Eigen::VectorXd accel_bias_sigma =
       blockSigma(*used, requested, state.accel_bias[0].data(),
                  Eigen::Vector3d::Constant(p.accel_bias_m_s2), scale);
@@ -177,16 +180,24 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
   for (size_t k = 0; k < n; ++k) {
     in.accel_bias_per_pose_m_s2.push_back(state.accelBias(static_cast<int>(k)));
   }
-  in.accel_bias_estimated = observability.accel_bias_estimated;
+  in.accel_bias_estimated =
+      observability.accel_bias_estimated &&
+      informedByTheData(accel_bias_sigma * unscale, Eigen::Vector3d::Constant(p.accel_bias_m_s2));
 
   const bool has_gyro = !problem.segments.empty();
   Eigen::VectorXd gyro_sigma =
       blockSigma(*used, requested, state.gyro_matrix.data(), gyro_prior, scale);
   for (int c = 0; c < 3; ++c) {
-    in.gyro_matrix_column_estimated[c] =
-        has_gyro && observability.gyro_column_estimated[c] && !identity;
+    Eigen::Vector3d column_sigma, column_prior;
     for (int r = 0; r < 3; ++r) {
-      const bool held = !in.gyro_matrix_column_estimated[c] && settings.pin_unexcited_parameters;
+      column_sigma(r) = gyro_sigma(3 * r + c) * unscale;
+      column_prior(r) = gyro_prior(3 * r + c);
+    }
+    in.gyro_matrix_column_estimated[c] = has_gyro && observability.gyro_column_estimated[c] &&
+                                         !identity && informedByTheData(column_sigma, column_prior);
+    for (int r = 0; r < 3; ++r) {
+      const bool held =
+          !observability.gyro_column_estimated[c] && settings.pin_unexcited_parameters;
       if (held || !has_gyro) gyro_sigma(3 * r + c) = gyro_prior(3 * r + c);
       if (identity) gyro_sigma(3 * r + c) = 0.0;
     }
@@ -206,10 +217,10 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
                  problem.poses[first_pose].gyro_mean_cov.diagonal().cwiseSqrt(), scale);
 
   in.magnetometer_used = observability.magnetometer_used;
-  in.soft_iron_estimated = observability.magnetometer_used && observability.soft_iron_estimated;
-  in.hard_iron_estimated = observability.magnetometer_used && observability.hard_iron_estimated;
   const Eigen::VectorXd soft_sigma =
       blockSigma(*used, requested, state.soft_iron.data(), soft_prior, scale);
+  in.soft_iron_estimated = observability.magnetometer_used && observability.soft_iron_estimated &&
+                           informedByTheData(soft_sigma * unscale, soft_prior);
   in.soft_iron =
       Eigen::Matrix3d::Identity() + sixToMatrix(toVector(state.soft_iron.data(), 6), true);
   in.soft_iron_sigma = sixToMatrix(soft_sigma, true);
@@ -218,6 +229,9 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
       blockSigma(*used, requested, state.hard_iron_ut.data(),
                  Eigen::Vector3d::Constant(p.hard_iron_t * kMicroteslaPerTesla), scale) /
       kMicroteslaPerTesla;
+  in.hard_iron_estimated =
+      observability.magnetometer_used && observability.hard_iron_estimated &&
+      informedByTheData(in.hard_iron_sigma_t * unscale, Eigen::Vector3d::Constant(p.hard_iron_t));
   if (observability.magnetometer_used) {
     in.magnetic_field_t = std::hypot(state.field_ut[0], state.field_ut[1]) / kMicroteslaPerTesla;
     in.magnetic_dip_rad = std::atan2(-state.field_ut[1], state.field_ut[0]);

@@ -87,11 +87,9 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
   JointSettings two_mount_settings = joint_settings;
   two_mount_settings.imu_matrices = one_mount.imu_matrices;
   two_mount_settings.compute_covariance = false;  // D and the pose residuals need the fit alone
-  // ... and the magnetometer used exactly when the one-mount estimate used it (its fields, below),
-  // whatever the coverage rule would say of them.
+  // ... and the magnetometer used exactly when the one-mount estimate used it (its fields, below).
   two_mount_settings.use_magnetometer =
       one_mount.intrinsics.magnetometer_used ? MagnetometerUse::kOn : MagnetometerUse::kOff;
-  two_mount_settings.min_mag_coverage_hard_iron = 0.0;
   // Candidates up to the newest pose: those with fewer than min_poses_after poses after them
   // compete for the location only (a change just before the newest pose must not be taken for
   // one a pose earlier, which would put an old-mount pose into the new mount).

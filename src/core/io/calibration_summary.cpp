@@ -90,7 +90,7 @@ void writeEstimate(std::ostream& out, const ReportInput& in) {
   out << "  " << rollPitchYawText(R, 4) << "\n";
 }
 
-/// The joint estimate: consistency, which IMU errors were estimated or held, what to rotate.
+/// The joint estimate: consistency, which IMU errors the data determined, what to rotate.
 void writeJoint(std::ostream& out, const JointResult& j) {
   if (!j.ok) {
     out << "joint estimate: FAILED (" << j.message << "); the pair solve is reported\n";
@@ -98,7 +98,10 @@ void writeJoint(std::ostream& out, const JointResult& j) {
   }
   out << "joint estimate: " << jointConsistencyText(j) << ", " << j.iterations << " iteration(s)\n";
   const ImuIntrinsics& i = j.intrinsics;
-  const auto state = [](bool estimated) { return estimated ? "estimated" : "held at prior"; };
+  // Every parameter is estimated with its prior; "estimated": the data determined it.
+  const auto state = [](bool estimated) {
+    return estimated ? "estimated" : "rests on its prior, in the 1-sigma";
+  };
   const bool gyro_any = i.gyro_matrix_column_estimated[0] || i.gyro_matrix_column_estimated[1] ||
                         i.gyro_matrix_column_estimated[2];
   out << "  gyro scale (%): "

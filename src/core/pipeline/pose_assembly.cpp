@@ -274,12 +274,14 @@ std::string CalibrationPipeline::Impl::assessCamera(const StationarySegment& seg
   // The frames inside the segment, margins off both ends; later ones are kept for the next rest.
   std::vector<Eigen::Matrix3d> rotations;
   double reprojection_sum = 0.0;
+  Eigen::Matrix3d pnp_cov_sum = Eigen::Matrix3d::Zero();
   const double lo = segment.start_s + settings.frame_margin_s;
   const double hi = segment.end_s - settings.frame_margin_s;
   for (const auto& d : detections) {
     if (d.stamp_s < lo || d.stamp_s > hi) continue;
     rotations.push_back(d.pose.R_target_cam);
     reprojection_sum += d.pose.reprojection_rms_px;
+    pnp_cov_sum += d.pose.cov_rotation_rad2;
     pose->p_target_cam = d.pose.p_target_cam;
   }
   std::vector<FrameDetection> later;
@@ -313,18 +315,30 @@ std::string CalibrationPipeline::Impl::assessCamera(const StationarySegment& seg
   pose->num_frames = average.num_inliers;
   pose->camera_spread_deg = average.spread_rms_deg;
   pose->reprojection_rms_px = reprojection_sum / static_cast<double>(rotations.size());
+  pose->camera_pnp_cov_rad2 = pnp_cov_sum / static_cast<double>(rotations.size());
   return "";
 }
 
 void CalibrationPipeline::Impl::acceptPose(const StationaryPose& pose,
                                            StationaryWindow::Entry joint_entry) {
   // The camera's covariance from the frames' scatter about their average (per axis, of the mean),
-  // with a floor for what the scatter cannot show (intrinsics, the target's flatness).
+  // with a floor for what the scatter cannot show (the target's flatness), plus the part of one
+  // frame's PnP covariance (from its reprojection residuals) beyond that scatter: residuals that
+  // the frames' scatter shows (pixel noise, as simulated) average out over the frames; the rest
+  // (the camera model's error: the frames of a rest see the same lens) repeats in every frame and
+  // is not divided by their number.
   const double spread_rad = deg2rad(pose.camera_spread_deg);
-  const double variance = spread_rad * spread_rad / (3.0 * std::max(1, pose.num_frames)) +
-                          std::pow(deg2rad(kCameraSigmaFloorDeg), 2);
+  const double frame_variance = spread_rad * spread_rad / 3.0;  // per axis, one frame
+  const double variance =
+      frame_variance / std::max(1, pose.num_frames) + std::pow(deg2rad(kCameraSigmaFloorDeg), 2);
+  Eigen::Matrix3d beyond_scatter = Eigen::Matrix3d::Zero();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> pnp(pose.camera_pnp_cov_rad2);
+  if (pnp.info() == Eigen::Success) {
+    const Eigen::Vector3d excess = (pnp.eigenvalues().array() - frame_variance).max(0.0).matrix();
+    beyond_scatter = pnp.eigenvectors() * excess.asDiagonal() * pnp.eigenvectors().transpose();
+  }
   joint_entry.joint.R_target_cam = pose.R_target_cam;
-  joint_entry.joint.cov_cam_rad2 = variance * Eigen::Matrix3d::Identity();
+  joint_entry.joint.cov_cam_rad2 = variance * Eigen::Matrix3d::Identity() + beyond_scatter;
   joint_entry.joint.group = pose.group;
   joint_entry.pose = pose;
   window.add(std::move(joint_entry));

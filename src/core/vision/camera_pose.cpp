@@ -2,9 +2,13 @@
 
 // Camera pose from a planar target: IPPE's two solutions, Levenberg-Marquardt refinement,
 // reprojection and ambiguity checks.
+#include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <sstream>
+
+#include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {
 
@@ -41,6 +45,42 @@ double reprojectionRms(const std::vector<cv::Point3d>& object,
   }
   if (mean) *mean = sum / image.size();
   return std::sqrt(sq / image.size());
+}
+
+/// sigma^2 (J^T J)^-1's rotation block for a pose (R_cam_target, t_cam_target) and its points:
+/// the pinhole projection's Jacobian with respect to a rotation Exp(e) R_cam_target (camera axes)
+/// and t, sigma^2 the sum of the squared residual coordinates over 2N - 6. Zero when not
+/// determined.
+Eigen::Matrix3d rotationCovariance(const std::vector<cv::Point3d>& object, double reprojection_rms,
+                                   const Eigen::Matrix3d& R_cam_target,
+                                   const Eigen::Vector3d& t_cam_target,
+                                   const CameraIntrinsics& camera) {
+  const int n = static_cast<int>(object.size());
+  if (n < 4) return Eigen::Matrix3d::Zero();
+  const double fx = camera.K(0, 0), fy = camera.K(1, 1);
+  Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
+  for (const cv::Point3d& point : object) {
+    const Eigen::Vector3d X(point.x, point.y, point.z);
+    const Eigen::Vector3d RX = R_cam_target * X;
+    const Eigen::Vector3d P = RX + t_cam_target;
+    if (!(P.z() > 1e-9)) return Eigen::Matrix3d::Zero();
+    Eigen::Matrix<double, 2, 3> d_uv_d_P;
+    d_uv_d_P << fx / P.z(), 0.0, -fx * P.x() / (P.z() * P.z()), 0.0, fy / P.z(),
+        -fy * P.y() / (P.z() * P.z());
+    Eigen::Matrix<double, 3, 6> d_P;
+    d_P.leftCols<3>() = -skew(RX);  // d(Exp(e) R X)/de at e = 0
+    d_P.rightCols<3>().setIdentity();
+    const Eigen::Matrix<double, 2, 6> J = d_uv_d_P * d_P;
+    information += J.transpose() * J;
+  }
+  // reprojection_rms^2 is the mean squared distance (both coordinates): per coordinate, its sum
+  // over the 2N - 6 degrees of freedom left.
+  const double sigma2 = reprojection_rms * reprojection_rms * n / std::max(1.0, 2.0 * n - 6.0);
+  const Eigen::Matrix<double, 6, 6> covariance =
+      sigma2 * information.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity());
+  const Eigen::Matrix3d rotation = covariance.topLeftCorner<3, 3>();
+  return rotation.allFinite() ? Eigen::Matrix3d(0.5 * (rotation + rotation.transpose()))
+                              : Eigen::Matrix3d::Zero();
 }
 
 /// Refined PnP solutions closer than this are the same minimum.
@@ -135,6 +175,9 @@ std::optional<CameraPose> estimateCameraPose(const TargetObservation& observatio
                                              tvecs[best], intrinsics, &pose.reprojection_mean_px);
   pose.ambiguity_ratio = ambiguity;
   pose.num_points = static_cast<int>(n);
+  // A left perturbation of R_cam_target is a right one of R_target_cam (sign flipped).
+  pose.cov_rotation_rad2 =
+      rotationCovariance(object, pose.reprojection_rms_px, R_cam_target, t_cam_target, intrinsics);
   if (why) why->clear();
   return pose;
 }
