@@ -176,7 +176,7 @@ bool runVisp(VispOutcome* out) {
     std::printf("pose %d: %d frames, reprojection %.2f px, camera spread %.4f deg\n", pose.index,
                 pose.num_frames, pose.reprojection_rms_px, pose.camera_spread_deg);
   }
-  out->result = pipeline.solve();
+  out->result = solveWindow(pipeline.snapshot(), pipeline.settings());
   if (out->result.status != SolveStatus::kOk || !out->result.joint || !out->result.joint->ok) {
     ADD_FAILURE() << out->result.message;
     return false;
