@@ -279,6 +279,16 @@ TEST(CalibrateBag, AMountThatMovedHalfwayExitsFourNamingThePose) {
   ASSERT_NE(at, std::string::npos) << result.run.out;
   const double error_deg = std::stod(result.run.out.substr(result.run.out.find(": ", at) + 2));
   EXPECT_LT(error_deg, 0.2) << result.run.out;
+  // --accept-last-mount: the new mount's estimate is written, the change named, exit 0.
+  const Calibration accepted =
+      calibrate(bag, "--accept-last-mount --truth " + stem(bag) + ".truth.yaml");
+  EXPECT_EQ(accepted.run.exit_code, 0) << accepted.run.err << accepted.run.out;
+  EXPECT_NE(accepted.run.out.find("verdict: PASSED for the last mount (--accept-last-mount): the "
+                                  "mount changed before pose " +
+                                  std::to_string(first_after) + " "),
+            std::string::npos)
+      << accepted.run.out;
+  EXPECT_LT(rad2deg(geodesicDistance(accepted.R_cam_imu, accepted.R_cam_imu_true)), 0.2);
   removeBag(bag);
 }
 

@@ -51,7 +51,8 @@ const char* kUsage =
     "                     [--imu-orientation joint|auto|magnetometer|message]\n"
     "                     [--output RESULT.yaml] [--imu-yaml IMU.yaml] [--report REPORT.png]\n"
     "                     [--truth TRUTH.yaml] [--export-poses POSES.csv]\n"
-    "                     [--check CURRENT.yaml] [--start S] [--end S] [--quiet]\n"
+    "                     [--check CURRENT.yaml] [--start S] [--end S]\n"
+    "                     [--accept-last-mount] [--quiet]\n"
     "  --bag FILE.bag        ROS 1 bag: sensor_msgs/Imu, optional MagneticField, Image or\n"
     "                        CompressedImage and CameraInfo (topics found by type when not given)\n"
     "  --target TARGET.yaml  Kalibr target file (checkerboard, aprilgrid, circlegrid)\n"
@@ -78,6 +79,9 @@ const char* kUsage =
     "                        not (nothing is written to --output / --imu-yaml)\n"
     "  --start S, --end S    read only the part of the bag from S to S (seconds from its\n"
     "                        first message; as rosbag play --start / --duration)\n"
+    "  --accept-last-mount   when the mount moved during the recording, write the estimate of the\n"
+    "                        mount after the last change (named in the verdict) instead of\n"
+    "                        exiting 4\n"
     "  --quiet               no progress on stderr\n"
     "exit codes: 0 success, 2 bad input or usage, 3 not enough information (the message says what\n"
     "motion is missing), 4 an estimate that fails the quality gates or a mount that moved during\n"
@@ -242,8 +246,13 @@ int run(const cia::CliArgs& args) {
   report.window_poses = snap.window.size();
   if (truth) report.truth = cia::KnownTruth{truth->R_cam_imu, args.get("--truth")};
   // The nodelet's verdict (decided in the core): a remount during the recording, a failed gate.
-  const bool gates_passed = outcome.verdict && outcome.verdict->passed;
-  if (outcome.verdict) report.verdict = cia::ReportVerdict{gates_passed, outcome.verdict->text};
+  const std::optional<cia::CalibrationVerdict> verdict =
+      args.has("--accept-last-mount")
+          ? cia::recordingVerdict({outcome.result, outcome.gate, outcome.window_poses},
+                                  snap.remount_events, true)
+          : outcome.verdict;
+  const bool gates_passed = verdict && verdict->passed;
+  if (verdict) report.verdict = cia::ReportVerdict{gates_passed, verdict->text};
   std::cout << cia::formatSummary(report);
   if (truth && report.result.status != cia::SolveStatus::kBadInput) {  // else: no estimate
     std::cout << std::fixed << std::setprecision(4) << "error to " << args.get("--truth") << ": "
@@ -322,7 +331,7 @@ int main(int argc, char** argv) {
           {"--bag", "--target", "--config", "--imu-topic", "--mag-topic", "--image-topic",
            "--camera-info-topic", "--method", "--imu-orientation", "--output", "--imu-yaml",
            "--report", "--truth", "--export-poses", "--check", "--start", "--end"},
-          {"--help", "--quiet"});
+          {"--help", "--quiet", "--accept-last-mount"});
     } catch (const cia::UsageError& e) {
       std::cerr << "calibrate_bag: " << e.what() << "\n" << kUsage;
       std::exit(kExitBadInput);

@@ -49,9 +49,12 @@ struct CalibrationVerdict {
 };
 
 /// The verdict of a solved estimate (none when it is not solved and observable: the estimate's own
-/// message says what is missing) given the remounts found since the start or the last reset.
+/// message says what is missing) given the remounts found since the start or the last reset. With
+/// `accept_last_mount` (calibrate_bag --accept-last-mount) a remount does not fail it: the estimate
+/// is the last mount's, from the poses after the change, and the verdict names the change.
 std::optional<CalibrationVerdict> recordingVerdict(const EstimateEvent& estimate,
-                                                   const std::vector<RemountEvent>& remounts);
+                                                   const std::vector<RemountEvent>& remounts,
+                                                   bool accept_last_mount = false);
 
 /// How far the window is from a broadcast estimate of the required precision.
 struct CalibrationProgress {

@@ -10,12 +10,23 @@
 namespace camera_imu_alignment {
 
 std::optional<CalibrationVerdict> recordingVerdict(const EstimateEvent& estimate,
-                                                   const std::vector<RemountEvent>& remounts) {
+                                                   const std::vector<RemountEvent>& remounts,
+                                                   bool accept_last_mount) {
   if (estimate.result.status != SolveStatus::kOk) return std::nullopt;
   const bool gates_passed = estimate.gate.decision != GateDecision::kReject;
   CalibrationVerdict verdict;
-  verdict.passed = gates_passed && remounts.empty();
-  if (!remounts.empty()) {
+  verdict.passed = gates_passed && (remounts.empty() || accept_last_mount);
+  if (!remounts.empty() && accept_last_mount) {
+    const RemountEvent& last = remounts.back();
+    char change[160];
+    std::snprintf(change, sizeof(change), "the mount changed before pose %d (by %.2f deg)",
+                  last.first_pose_index, last.change_deg);
+    verdict.text = gates_passed
+                       ? std::string("PASSED for the last mount (--accept-last-mount): ") + change +
+                             "; the estimate is from the " + std::to_string(estimate.window_poses) +
+                             " poses after it"
+                       : "FAILED: " + estimate.gate.why + " (the last mount, after " + change + ")";
+  } else if (!remounts.empty()) {
     verdict.text = "FAILED: the mount changed during the recording (first before pose " +
                    std::to_string(remounts.front().first_pose_index) +
                    "); the estimate is of the last mount, from the poses after the change";
