@@ -407,6 +407,9 @@ TEST(CalibrateBag, StartAndEndReadAPartOfTheBag) {
 TEST(CalibrateBag, BadUsageAndInputsExitTwoNamingTheCulprit) {
   const std::string bag = simulate("usage", "--scenario nominal --seed 30 --num-poses 3");
   const std::string target = stem(bag) + ".target.yaml";
+  const std::string typo = temp("typo.yaml"), never = temp("never_broadcast.yaml");
+  std::ofstream(typo) << "min_pose: 3\n";
+  std::ofstream(never) << "window_poses: 30\nmin_poses: 40\n";
   struct Bad {
     std::string args, expected;
   };
@@ -420,6 +423,10 @@ TEST(CalibrateBag, BadUsageAndInputsExitTwoNamingTheCulprit) {
        "sensor_msgs/Image"},
       {"--bag " + bag + " --target " + target + " --method best", "--method"},
       {"--bag " + bag + " --target " + target + " --config " + target, "unknown key"},
+      {"--bag " + bag + " --target " + target + " --config " + typo,
+       typo + ": unknown key 'min_pose' (see config/default.yaml); did you mean 'min_poses'?"},
+      {"--bag " + bag + " --target " + target + " --config " + never,
+       never + ": min_poses = 40 > window_poses = 30"},
   };
   for (const Bad& b : bad) {
     const test::ToolRun r = test::runTool(kCalibrate + " " + b.args);
