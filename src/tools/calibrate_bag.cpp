@@ -77,7 +77,7 @@ const char* kUsage =
     "                        difference to the bag's joint estimate in degrees and sigmas and the\n"
     "                        chi-square test at consistency_level: exit 0 when consistent, 4 when\n"
     "                        not (nothing is written to --output / --imu-yaml)\n"
-    "  --start S, --end S    read only the part of the bag from S to S (seconds from its\n"
+    "  --start S, --end S    read only the part of the bag between them (seconds from its\n"
     "                        first message; as rosbag play --start / --duration)\n"
     "  --accept-last-mount   when the mount moved during the recording, write the estimate of the\n"
     "                        mount after the last change (named in the verdict) instead of\n"
