@@ -19,10 +19,6 @@ namespace {
 
 using Key = SettingKey<WrapperSettings>;
 
-/// The member `path` of a WrapperSettings (const or not).
-#define CIA_MEMBER(path) \
-  [](auto& s) -> auto& { return s.path; }
-
 const std::vector<Key>& keys() {
   const char* const frame = "a tf frame name (text), or empty";
   static const std::vector<Key> table = {
@@ -47,8 +43,6 @@ const std::vector<Key>& keys() {
   };
   return table;
 }
-
-#undef CIA_MEMBER
 
 /// XmlRpc parameter value -> YAML node (scalars and lists; maps are not settings).
 YAML::Node toYaml(XmlRpc::XmlRpcValue& value, const std::string& name) {

@@ -21,10 +21,6 @@ namespace sim = simulation;
 using Options = SimulateBagOptions;
 using Key = SettingKey<Options>;
 
-/// The member `path` of the options (const or not).
-#define CIA_MEMBER(path) \
-  [](auto& o) -> auto& { return o.path; }
-
 template <typename T, typename Access>
 Key number(const std::string& name, Access access, SettingRange range, const std::string& unit,
            const std::string& description) {
@@ -325,8 +321,6 @@ const std::vector<Key>& simulateBagOptionTable() {
   };
   return table;
 }
-
-#undef CIA_MEMBER
 
 std::set<std::string> simulateBagValueOptions() {
   std::set<std::string> names = {"--out"};

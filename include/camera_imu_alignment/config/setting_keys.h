@@ -25,6 +25,11 @@
 #include <utility>
 #include <vector>
 
+/// A table entry's access to the member `path` of the settings (const or not): the `access` of
+/// numberKey and the other key makers, e.g. CIA_MEMBER(joint.priors.gyro_scale).
+#define CIA_MEMBER(path) \
+  [](auto& settings) -> auto& { return settings.path; }
+
 namespace camera_imu_alignment {
 
 /// A numeric range: [min, max], either end open or infinite. Doubles must also be finite.

@@ -14,10 +14,6 @@ namespace {
 
 using Key = SettingKey<OnlineSettings>;
 
-/// The member `path` of an OnlineSettings (const or not).
-#define CIA_MEMBER(path) \
-  [](auto& s) -> auto& { return s.path; }
-
 template <typename T, typename Access>
 Key number(const std::string& name, Access access, SettingRange range, const std::string& unit,
            const std::string& description) {
@@ -57,8 +53,6 @@ const std::vector<Key>& onlineKeys() {
   };
   return table;
 }
-
-#undef CIA_MEMBER
 
 const std::vector<std::string>& onlineConfigKeys() {
   static const std::vector<std::string> names = keyNames(onlineKeys());

@@ -17,10 +17,6 @@ namespace {
 
 using Key = SettingKey<PipelineSettings>;
 
-/// The member `path` of a PipelineSettings (const or not).
-#define CIA_MEMBER(path) \
-  [](auto& s) -> auto& { return s.path; }
-
 template <typename T, typename Access>
 Key number(const std::string& name, Access access, SettingRange range, const std::string& unit,
            const std::string& description) {
@@ -194,8 +190,6 @@ const std::vector<Key>& keys() {
   };
   return table;
 }
-
-#undef CIA_MEMBER
 
 }  // namespace
 
