@@ -204,8 +204,6 @@ class CalibrationPipeline : public SampleSink {
   /// Forgets all data (poses, window, buffers; counts kept unless clear_counts); the camera
   /// intrinsics stay. Not from a callback.
   void reset(bool clear_counts = false);
-  /// Keeps only the newest `count` poses in the solver's window (a remount); callbacks may call it.
-  void keepNewestPoses(std::size_t count);
   /// Keeps the window's poses with StationaryPose::index >= `pose_index` (a remount found by
   /// index, which stays valid while newer poses arrive).
   void keepPosesFrom(int pose_index);

@@ -31,9 +31,8 @@ class StationaryWindow {
   /// when an orientation is not a finite rotation matrix.
   bool add(Entry entry);
   void clear() { entries_.clear(); }
-  /// Drops all but the newest `count` entries (a remount: older ones describe the old mount).
-  void keepNewest(std::size_t count);
-  /// Keeps the entries whose StationaryPose::index >= pose_index.
+  /// Keeps the entries whose StationaryPose::index >= pose_index (a remount: older ones describe
+  /// the old mount).
   void keepFrom(int pose_index);
   std::size_t size() const { return entries_.size(); }
   std::size_t maxPoses() const { return max_poses_; }

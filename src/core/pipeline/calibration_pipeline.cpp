@@ -334,7 +334,6 @@ void CalibrationPipeline::reset(bool clear_counts) {
   }
 }
 
-void CalibrationPipeline::keepNewestPoses(std::size_t count) { impl_->window.keepNewest(count); }
 std::size_t CalibrationPipeline::windowSize() const { return impl_->window.size(); }
 
 const std::vector<StationaryPose>& CalibrationPipeline::poses() const { return impl_->poses; }

@@ -21,10 +21,6 @@ bool StationaryWindow::add(Entry entry) {
   return true;
 }
 
-void StationaryWindow::keepNewest(std::size_t count) {
-  while (entries_.size() > count) entries_.pop_front();
-}
-
 void StationaryWindow::keepFrom(int pose_index) {
   while (!entries_.empty() && entries_.front().pose.index < pose_index) entries_.pop_front();
 }
