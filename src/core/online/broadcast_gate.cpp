@@ -22,33 +22,50 @@ const char* toString(GateDecision decision) {
   return "?";
 }
 
+namespace {
+
+/// The difference between a joint estimate and a current calibration: its rotation vector
+/// (rad, camera axes), and its chi-square (3 dof) under the estimate's covariance plus the current
+/// one's when it has one; nullopt without a joint estimate or a usable covariance.
+struct Difference {
+  Eigen::Vector3d rotation_rad;
+  double chi2 = 0;
+  double p_value = 1;
+};
+
+std::optional<Difference> differenceOf(const AlignmentResult& estimate,
+                                       const BroadcastEstimate& current) {
+  if (!estimate.joint || !estimate.joint->ok) return std::nullopt;
+  Eigen::Matrix3d covariance = estimate.joint->covariance_rad2;
+  if (current.covariance_rad2) covariance += *current.covariance_rad2;
+  if (!covariance.allFinite() || !(covariance.determinant() > 0.0)) return std::nullopt;
+  Difference d;
+  d.rotation_rad = logSO3(estimate.R_cam_imu * current.R_cam_imu.transpose());
+  d.chi2 = d.rotation_rad.dot(covariance.inverse() * d.rotation_rad);
+  if (!std::isfinite(d.chi2)) return std::nullopt;
+  d.p_value = boost::math::cdf(boost::math::complement(boost::math::chi_squared(3.0), d.chi2));
+  return d;
+}
+
+}  // namespace
+
 double differenceSignificance(const AlignmentResult& result, const BroadcastEstimate& broadcast) {
-  if (!broadcast.covariance_rad2 || !result.joint || !result.joint->ok) return 1.0;
-  const Eigen::Vector3d difference = logSO3(result.R_cam_imu * broadcast.R_cam_imu.transpose());
-  const Eigen::Matrix3d covariance = result.joint->covariance_rad2 + *broadcast.covariance_rad2;
-  if (!covariance.allFinite() || !(covariance.determinant() > 0.0)) return 1.0;
-  const double chi2 = difference.dot(covariance.inverse() * difference);
-  if (!std::isfinite(chi2)) return 1.0;
-  return boost::math::cdf(boost::math::complement(boost::math::chi_squared(3.0), chi2));
+  if (!broadcast.covariance_rad2) return 1.0;
+  const std::optional<Difference> d = differenceOf(result, broadcast);
+  return d ? d->p_value : 1.0;
 }
 
 std::optional<CalibrationCheck> checkCalibration(const AlignmentResult& estimate,
                                                  const BroadcastEstimate& current,
                                                  double consistency_level) {
-  if (estimate.status != SolveStatus::kOk || !estimate.joint || !estimate.joint->ok) {
-    return std::nullopt;
-  }
-  Eigen::Matrix3d covariance = estimate.joint->covariance_rad2;
-  if (current.covariance_rad2) covariance += *current.covariance_rad2;
-  if (!covariance.allFinite() || !(covariance.determinant() > 0.0)) return std::nullopt;
+  if (estimate.status != SolveStatus::kOk) return std::nullopt;
+  const std::optional<Difference> d = differenceOf(estimate, current);
+  if (!d) return std::nullopt;
   CalibrationCheck check;
-  const Eigen::Vector3d difference = logSO3(estimate.R_cam_imu * current.R_cam_imu.transpose());
-  check.error_deg = rad2deg(difference.norm());
-  check.chi2 = difference.dot(covariance.inverse() * difference);
-  if (!std::isfinite(check.chi2)) return std::nullopt;
+  check.error_deg = rad2deg(d->rotation_rad.norm());
+  check.chi2 = d->chi2;
   check.sigmas = std::sqrt(check.chi2);
-  check.p_value =
-      boost::math::cdf(boost::math::complement(boost::math::chi_squared(3.0), check.chi2));
+  check.p_value = d->p_value;
   check.consistent = check.p_value >= consistency_level;
   std::ostringstream text;
   text.precision(3);
