@@ -56,7 +56,7 @@ void expectAccurate(const CalibrationPipeline& pipeline, const Eigen::Matrix3d& 
 TEST(CalibrationPipeline, NominalRunFindsEveryPoseAndTheMounting) {
   // Through the online calibrator (the product's path), solving on this thread.
   const auto r = test::runCalibrator(scenario("nominal", 3));
-  const CalibrationSnapshot snap = r.calibrator->snapshot();
+  const CalibrationSnapshot snap = r.calibrator->snapshot(SnapshotContents::kWithHistory);
   const auto& trajectory = r.run->trajectory;
   const auto& poses = snap.poses;
   EXPECT_EQ(poses.size(), trajectory.poses().size()) << snap.rejections.summary();
@@ -280,7 +280,7 @@ TEST(CalibrationPipeline, ATargetPartlyOrNotInViewIsCountedAndGivesNoPose) {
     settings.min_frame_interval_s = 0.15;
     settings.missed_frame_interval_s = 1.0;
     const auto r = test::runCalibrator(c, settings, injection);
-    const CalibrationSnapshot snap = r.calibrator->snapshot();
+    const CalibrationSnapshot snap = r.calibrator->snapshot(SnapshotContents::kWithHistory);
     EXPECT_EQ(snap.poses_total, 0u) << covered;
     // After 3 misses in a row at a rest, one attempt per missed_frame_interval_s (a miss costs
     // up to 15x a hit); at min_frame_interval_s a 4 s rest would cost about 25 attempts.

@@ -96,7 +96,7 @@ TEST(CalibrationSnapshot, WindowIsWhatTheEstimateUsedAndProgressReachesTheTarget
   const sim::SimulationConfig c = consumerRecording(42);
   OnlineSettings online;
   const auto calibrator = calibrated(c, online);
-  const CalibrationSnapshot snap = calibrator->snapshot();
+  const CalibrationSnapshot snap = calibrator->snapshot(SnapshotContents::kWithHistory);
   ASSERT_TRUE(snap.latest);
   EXPECT_EQ(snap.window.size(), snap.latest->window_poses);
   ASSERT_FALSE(snap.window.empty());
@@ -105,6 +105,11 @@ TEST(CalibrationSnapshot, WindowIsWhatTheEstimateUsedAndProgressReachesTheTarget
     EXPECT_LT(snap.window[i - 1].index, snap.window[i].index);
   }
   EXPECT_EQ(snap.windowOrientations().size(), snap.window.size());
+  // The state alone (the status' copy) leaves the histories out, not the window.
+  const CalibrationSnapshot state = calibrator->snapshot();
+  EXPECT_TRUE(state.poses.empty() && state.rests.empty() && state.rejected_poses.empty());
+  EXPECT_EQ(state.window.size(), snap.window.size());
+  EXPECT_EQ(state.poses_total, snap.poses_total);
   // A passed estimate is broadcast, needs no more poses and carries its own 1-sigma.
   ASSERT_TRUE(snap.broadcast && snap.verdict);
   EXPECT_TRUE(snap.verdict->passed) << snap.verdict->text;

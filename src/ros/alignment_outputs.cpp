@@ -201,7 +201,7 @@ void AlignmentWrapper::Impl::publishStatus() {
 void AlignmentWrapper::Impl::publishPoses() {
   // Camera orientations at the poses, in the target frame (rviz: fixed frame = the target).
   geometry_msgs::PoseArray out;
-  const CalibrationSnapshot snap = calibrator->snapshot();
+  const CalibrationSnapshot snap = calibrator->snapshot(SnapshotContents::kWithHistory);
   out.header.stamp = ros::Time(std::max(snap.newest_stamp_s, 0.0));
   out.header.frame_id = "calibration_target";
   for (const StationaryPose& p : snap.window) {

@@ -33,7 +33,7 @@ void BagProgress::update(double t, const OnlineCalibrator& calibrator, bool forc
   const int step = tty_ ? 1 : 10;
   if (!force && percent / step == last_ / step) return;
   last_ = percent;
-  const CalibrationSnapshot snap = calibrator.snapshot();
+  const CalibrationSnapshot snap = calibrator.snapshot(SnapshotContents::kWithHistory);
   std::ostringstream line;
   line << "[calibrate_bag] " << std::setw(3) << std::min(percent, 100) << "% of bag time, "
        << snap.rests.size() << " rests, " << snap.poses.size() << " poses";

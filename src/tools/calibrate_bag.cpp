@@ -214,7 +214,7 @@ int run(const cia::CliArgs& args) {
 
   // --- Verdict.
   const cia::CalibrateOutcome outcome = calibrator->calibrateNow(false);
-  const cia::CalibrationSnapshot snap = calibrator->snapshot();
+  const cia::CalibrationSnapshot snap = calibrator->snapshot(cia::SnapshotContents::kWithHistory);
   std::cerr << "[calibrate_bag] read " << snap.inputs.imu_samples << " IMU, "
             << snap.inputs.magnetic_samples << " magnetometer samples, " << info.image_messages
             << " images; " << snap.rests.size() << " stationary rests, " << snap.poses.size()

@@ -81,6 +81,11 @@ std::string imuGuidanceOf(const EstimateEvent& estimate);
 CalibrationProgress progressOf(const std::optional<EstimateEvent>& estimate,
                                double max_std_dev_deg);
 
+/// What OnlineCalibrator::snapshot() copies: the state alone (the status and diagnostics, published
+/// every second and on every change), or also the histories of poses, rests and rejected rests (up
+/// to CalibrationPipeline::kHistoryLimit each: the report, the progress line, the pose markers).
+enum class SnapshotContents { kState, kWithHistory };
+
 /// Input counters since the start (kept over a reset); cheap to read per sample.
 struct InputCounts {
   std::uint64_t imu_samples = 0, magnetic_samples = 0, frames = 0;
@@ -108,9 +113,10 @@ struct CalibrationSnapshot {
   // --- poses
   std::size_t rests_total = 0, poses_total = 0;  ///< since the start or the last reset
   std::vector<StationaryPose> window;            ///< the poses the next solve uses, oldest first
-  std::vector<StationaryPose> poses;             ///< the newest kHistoryLimit poses
-  std::vector<RejectedPose> rejected_poses;      ///< rests that became no pose (newest)
-  std::vector<StationarySegment> rests;          ///< the newest kHistoryLimit IMU rests
+  // With SnapshotContents::kWithHistory only (empty otherwise):
+  std::vector<StationaryPose> poses;         ///< the newest kHistoryLimit poses
+  std::vector<RejectedPose> rejected_poses;  ///< rests that became no pose (newest)
+  std::vector<StationarySegment> rests;      ///< the newest kHistoryLimit IMU rests
   std::optional<StationaryPose> last_pose;
 
   // --- estimates

@@ -107,10 +107,9 @@ class OnlineCalibrator : public SampleSink {
   /// Newest stamp on any input (s), -1 before the first.
   double newestStamp() const;
   const OnlineSettings& settings() const;
-  /// Everything the outputs show, as one value (calibration_snapshot.h). Copies the pose
-  /// histories (at most CalibrationPipeline::kHistoryLimit each): call it per output, not per
-  /// sample.
-  CalibrationSnapshot snapshot() const;
+  /// Everything the outputs show, as one value (calibration_snapshot.h); the pose histories only
+  /// with kWithHistory. Call it per output, not per sample.
+  CalibrationSnapshot snapshot(SnapshotContents contents = SnapshotContents::kState) const;
   /// The input counters alone (cheap: per sample).
   InputCounts inputCounts() const;
 

@@ -446,7 +446,7 @@ InputCounts OnlineCalibrator::inputCounts() const {
   return counts;
 }
 
-CalibrationSnapshot OnlineCalibrator::snapshot() const {
+CalibrationSnapshot OnlineCalibrator::snapshot(SnapshotContents contents) const {
   const Impl& c = *impl_;
   const CalibrationPipeline& p = *c.pipeline;
   CalibrationSnapshot s;
@@ -459,9 +459,11 @@ CalibrationSnapshot OnlineCalibrator::snapshot() const {
   s.rests_total = p.restsTotal();
   s.poses_total = p.posesTotal();
   s.window = p.windowPoses();
-  s.poses = p.poses();
-  s.rejected_poses = p.rejectedPoses();
-  s.rests = p.segments();
+  if (contents == SnapshotContents::kWithHistory) {
+    s.poses = p.poses();
+    s.rejected_poses = p.rejectedPoses();
+    s.rests = p.segments();
+  }
   s.last_pose = c.last_pose;
   s.latest = c.last_estimate;
   s.broadcast = c.broadcast;
