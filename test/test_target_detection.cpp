@@ -26,6 +26,7 @@
 #include "camera_imu_alignment/vision/target_description.h"
 #include "camera_imu_alignment/vision/target_detector.h"
 #include "test_helpers.h"
+#include "visp_data.h"
 
 namespace camera_imu_alignment {
 namespace {
@@ -495,32 +496,13 @@ TEST(CameraPose, ReportedRotationCovarianceMatchesTheScatterUnderPixelNoise) {
 #define CIA_REALDATA_DIR "/work/shared/realdata"
 #endif
 
-/// ViSP's flange pose file (rows: 6, data: [[tx], [ty], [tz], [tux], [tuy], [tuz]]) -> rotation.
-bool readVispRotation(const std::string& path, Eigen::Matrix3d* R) {
-  try {
-    const YAML::Node data = YAML::LoadFile(path)["data"];
-    if (!data || data.size() != 6) return false;
-    const Eigen::Vector3d theta_u(data[3][0].as<double>(), data[4][0].as<double>(),
-                                  data[5][0].as<double>());
-    *R = expSO3(theta_u);  // p_base = R(theta u) p_flange + t
-    return true;
-  } catch (const YAML::Exception&) {
-    return false;
-  }
-}
-
 TEST(VispRealImages, AllChessboardsFoundAndRotationMatchesVisp) {
-  const std::string dir = std::string(CIA_REALDATA_DIR) + "/visp_franka_eye_in_hand";
+  const std::string dir = test::vispDir();
   if (!std::ifstream(dir + "/franka_image-1.png")) GTEST_SKIP() << "no realdata at " << dir;
-  TargetDescription board;
-  board.type = TargetDescription::Type::kCheckerboard;
-  board.cols = 9;
-  board.rows = 6;
-  board.row_spacing_m = board.col_spacing_m = 0.0236;
-  const double K[9] = {607.5931, 0, 323.4628, 0, 607.5750, 243.2553, 0, 0, 1};
+  const TargetDescription board = test::vispBoard();
   CameraIntrinsics intrinsics;
   std::string error;
-  ASSERT_TRUE(CameraIntrinsics::fromCameraInfo(640, 480, K, "", {}, &intrinsics, &error));
+  ASSERT_TRUE(test::vispIntrinsics(&intrinsics, &error)) << error;
   const TargetDetector detector(board);
   std::vector<PoseOrientation> poses;
   for (int i = 1; i <= 8; ++i) {
@@ -539,17 +521,14 @@ TEST(VispRealImages, AllChessboardsFoundAndRotationMatchesVisp) {
     PoseOrientation p;
     p.stamp_s = i;
     p.R_target_cam = pose->R_target_cam;
-    ASSERT_TRUE(
-        readVispRotation(dir + "/franka_pose_rPe_" + std::to_string(i) + ".yaml", &p.R_world_imu))
+    ASSERT_TRUE(test::readVispFlangeRotation(
+        dir + "/franka_pose_rPe_" + std::to_string(i) + ".yaml", &p.R_world_imu))
         << i;
     poses.push_back(p);
   }
   const AlignmentResult result = solveAlignment(makeAllPairs(poses));
   ASSERT_EQ(result.status, SolveStatus::kOk) << result.message;
-  Eigen::Matrix3d R_imu_cam_visp;
-  R_imu_cam_visp << -0.0110121, -0.999915, 0.0069391, 0.999929, -0.0109794, 0.00473584, -0.00465925,
-      0.00699075, 0.999965;
-  const double error_deg = test::angleBetweenDeg(result.R_cam_imu, R_imu_cam_visp.transpose());
+  const double error_deg = test::angleBetweenDeg(result.R_cam_imu, test::vispCameraImu());
   std::cout << "ViSP Franka: R_cam_imu differs from ViSP's estimate by " << error_deg << " deg\n";
   EXPECT_LT(error_deg, 0.1);
 }

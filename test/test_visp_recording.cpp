@@ -27,39 +27,15 @@
 #include "camera_imu_alignment/simulation/trajectory.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 
-#ifndef CIA_REALDATA_DIR
-#define CIA_REALDATA_DIR "/work/shared/realdata"
-#endif
+#include "visp_data.h"
 
 namespace camera_imu_alignment {
 namespace {
 
-const std::string kDir = std::string(CIA_REALDATA_DIR) + "/visp_franka_eye_in_hand";
+const std::string kDir = test::vispDir();
 constexpr int kPoses = 8;
 constexpr double kRestS = 4.0, kMoveS = 3.0, kImuRateHz = 200.0, kFrameRateHz = 5.0;
 constexpr double kGravity = 9.81;
-
-/// ViSP's flange pose file (rows: 6, data: [[tx], [ty], [tz], [tux], [tuy], [tuz]]) ->
-/// R_base_flange.
-bool readFlangeRotation(const std::string& path, Eigen::Matrix3d* R) {
-  try {
-    const YAML::Node data = YAML::LoadFile(path)["data"];
-    if (!data || data.size() != 6) return false;
-    *R = expSO3(
-        Eigen::Vector3d(data[3][0].as<double>(), data[4][0].as<double>(), data[5][0].as<double>()));
-    return true;
-  } catch (const YAML::Exception&) {
-    return false;
-  }
-}
-
-/// ViSP's published eMc rotation (p_flange = eMc p_cam), transposed: R_cam_imu.
-Eigen::Matrix3d vispCameraImu() {
-  Eigen::Matrix3d R_imu_cam;
-  R_imu_cam << -0.0110121, -0.999915, 0.0069391, 0.999929, -0.0109794, 0.00473584, -0.00465925,
-      0.00699075, 0.999965;
-  return projectToSO3(R_imu_cam).transpose();
-}
 
 struct VispRecording {
   std::vector<Eigen::Matrix3d> R_world_imu;
@@ -69,7 +45,8 @@ struct VispRecording {
 bool loadRecording(VispRecording* out) {
   for (int i = 1; i <= kPoses; ++i) {
     Eigen::Matrix3d R;
-    if (!readFlangeRotation(kDir + "/franka_pose_rPe_" + std::to_string(i) + ".yaml", &R)) {
+    if (!test::readVispFlangeRotation(kDir + "/franka_pose_rPe_" + std::to_string(i) + ".yaml",
+                                      &R)) {
       return false;
     }
     const cv::Mat image =
@@ -158,15 +135,10 @@ struct VispOutcome {
 bool runVisp(VispOutcome* out) {
   VispRecording rec;
   if (!loadRecording(&rec)) return false;
-  TargetDescription board;
-  board.type = TargetDescription::Type::kCheckerboard;
-  board.cols = 9;
-  board.rows = 6;
-  board.row_spacing_m = board.col_spacing_m = 0.0236;
-  const double K[9] = {607.5931, 0, 323.4628, 0, 607.5750, 243.2553, 0, 0, 1};
+  const TargetDescription board = test::vispBoard();
   CameraIntrinsics intrinsics;
   std::string error;
-  EXPECT_TRUE(CameraIntrinsics::fromCameraInfo(640, 480, K, "", {}, &intrinsics, &error)) << error;
+  EXPECT_TRUE(test::vispIntrinsics(&intrinsics, &error)) << error;
   const PipelineSettings settings;
   CalibrationPipeline pipeline(board, settings);
   EXPECT_TRUE(pipeline.setCameraIntrinsics(intrinsics));
@@ -182,7 +154,7 @@ bool runVisp(VispOutcome* out) {
     return false;
   }
   const JointResult& joint = *out->result.joint;
-  out->error_deg = rad2deg(geodesicDistance(out->result.R_cam_imu, vispCameraImu()));
+  out->error_deg = rad2deg(geodesicDistance(out->result.R_cam_imu, test::vispCameraImu()));
   std::printf("ViSP recording: %s\nR_cam_imu %.3f deg from ViSP's eMc\n", joint.message.c_str(),
               out->error_deg);
   for (const std::string& note : joint.notes) std::printf("  note: %s\n", note.c_str());
