@@ -44,6 +44,19 @@ GyroPreintegration preintegrateGyro(const std::vector<double>& stamps_s,
                                     double t_to_s, const Eigen::Matrix3d& T_g,
                                     const Eigen::Vector3d& b_from, const Eigen::Vector3d& b_to);
 
+/// The same over exactly [t_from_s, t_to_s] of an unbroken stream (continuous motion, where the
+/// interval's ends fall between samples): each sample is the rate at its stamp, the rate between
+/// two samples is interpolated linearly (a zero-order hold would shift the rotation by half a
+/// sample period, a time offset of 2.5 ms at 200 Hz), and the bias ramps from b_from at t_from_s to
+/// b_to at t_to_s. The stream must cover the interval (stamps_s.front() <= t_from_s < t_to_s <=
+/// stamps_s.back()). rate_from/rate_to (optional): the calibrated body rate T_g^-1 (w - b) at the
+/// ends (rad/s, IMU frame), the derivative of the rotation with respect to the interval's ends.
+GyroPreintegration preintegrateGyroInterval(
+    const std::vector<double>& stamps_s, const std::vector<Eigen::Vector3d>& gyro_rad_s,
+    double t_from_s, double t_to_s, const Eigen::Matrix3d& T_g, const Eigen::Vector3d& b_from,
+    const Eigen::Vector3d& b_to, Eigen::Vector3d* rate_from = nullptr,
+    Eigen::Vector3d* rate_to = nullptr);
+
 /// DeltaR(theta) to first order from a preintegration at theta0: delta_R Exp(J (theta - theta0)).
 Eigen::Matrix3d correctedDeltaR(const GyroPreintegration& preintegration,
                                 const GyroModelVector& theta);

@@ -42,6 +42,26 @@ struct JointPose {
   /// hard iron changes the norm by a third with the orientation). The estimator tries such a
   /// field with the iron calibrated and keeps it when it fits (JointEstimator: screening).
   bool mag_flagged = false;
+  /// False: not a rest but the camera's orientation at one instant of continuous motion (a node
+  /// the estimator makes of JointProblem::motion_frames; start_s = end_s = its stamp, camera
+  /// clock): no accelerometer, gyro-mean or magnetometer residual, only the camera prior and the
+  /// gyro between it and its neighbours. Callers leave it true.
+  bool at_rest = true;
+};
+
+/// The camera's orientation at a frame during motion (the target seen, or a camera_pose message).
+struct MotionFrame {
+  double stamp_s = 0;  ///< camera clock (s): t_imu = stamp_s + timeshift_cam_imu_s
+  Eigen::Matrix3d R_target_cam = Eigen::Matrix3d::Identity();
+  /// Covariance of R_target_cam (rad^2, camera axes, right perturbation), e.g. PnP's.
+  Eigen::Matrix3d cov_cam_rad2 = Eigen::Matrix3d::Zero();
+};
+
+/// An unbroken stream of raw gyro samples (IMU clock, strictly increasing stamps, no gaps).
+struct GyroStream {
+  std::vector<double> stamps_s;
+  std::vector<Eigen::Vector3d> gyro_rad_s;  ///< raw, gyro axes
+  double noise_density_rad_s_sqrt_hz = 0;   ///< measured white noise (rad/s/sqrt(Hz))
 };
 
 /// Raw gyro samples from the end of rest `from_pose` to the start of rest `to_pose`. Sample i holds
@@ -51,6 +71,12 @@ struct GyroSegment {
   std::vector<double> stamps_s;    ///< strictly increasing (s)
   std::vector<Eigen::Vector3d> gyro_rad_s;  ///< raw, gyro axes
   double noise_density_rad_s_sqrt_hz = 0;   ///< measured white noise (rad/s/sqrt(Hz))
+  /// Set by the estimator for the segments it makes around motion nodes (callers leave them):
+  /// the samples are integrated over exactly [from, to] with the rate interpolated between
+  /// samples (preintegrateGyroInterval), where an end at a motion node is that node's stamp
+  /// shifted by the time offset (t_imu = t_cam + timeshift_cam_imu_s) and an end at a rest is the
+  /// rest's end (from) or start (to).
+  bool interval = false;
 };
 
 struct JointProblem {
@@ -61,6 +87,20 @@ struct JointProblem {
   /// and the gyro segment into this pose (the motion during which the mount moved) is not used.
   /// -1: one mount for all poses.
   int mount_change_pose = -1;
+
+  /// Continuous motion (no rests needed): the camera's orientation at the frames outside the rests
+  /// (stamp order) and the raw gyro over them (covering every frame's stamp plus the time offset).
+  /// The estimator takes nodes from the frames (JointSettings::motion_node_spacing_s) and links
+  /// consecutive nodes and rests by the gyro between them (the segment between two rests with
+  /// nodes in between is then replaced by the chain through the nodes). The accelerometer is not
+  /// used during motion (it measures gravity plus the rig's acceleration).
+  std::vector<MotionFrame> motion_frames;
+  GyroStream motion_gyro;
+  /// The camera-IMU time offset, Kalibr's timeshift_cam_imu (t_imu = t_cam + timeshift; s):
+  /// estimated with the motion nodes, from this initial value (e.g. coarseTimeshift,
+  /// motion_pairs.h) under a Gaussian prior of this 1-sigma (s). Unused without motion frames.
+  double timeshift_initial_s = 0;
+  double timeshift_prior_sigma_s = 0.05;
 };
 
 /// 1-sigma of the Gaussian priors on the IMU parameters (mean: the ideal sensor, T = I, bias 0).
@@ -149,6 +189,14 @@ struct JointSettings {
   double mag_mean_sigma_floor_t = 5e-8;
   double camera_sigma_floor_rad = 1e-5;
   double gyro_integration_sigma_floor_rad = 1e-5;
+
+  /// Motion nodes (JointProblem::motion_frames): consecutive nodes are at least this far apart
+  /// (s). Shorter intervals add nodes (parameters) whose rotation is barely above the camera's
+  /// noise; longer ones leave frames unused.
+  double motion_node_spacing_s = 0.1;
+  /// Motion nodes further than this (s) from the next node or rest are linked to it only when
+  /// the gyro covers the gap: beyond it the chain breaks (the target was out of view).
+  double motion_max_link_s = 2.0;
 };
 
 }  // namespace camera_imu_alignment

@@ -95,6 +95,13 @@ struct JointResult {
   std::vector<double> mag_residual_chi2;
   /// Poses whose field was left out as disturbed: it did not fit the calibrated iron and field.
   std::vector<int> mag_poses_left_out;
+  /// The camera-IMU time offset (Kalibr's timeshift_cam_imu: t_imu = t_cam + timeshift; s) and
+  /// its 1-sigma, estimated with motion nodes (timeshift_estimated); else 0 and not estimated.
+  double timeshift_cam_imu_s = 0;
+  double timeshift_sigma_s = 0;
+  bool timeshift_estimated = false;
+  int motion_nodes = 0;      ///< motion nodes used (JointProblem::motion_frames)
+  int rests_used = 0;        ///< rests used (JointProblem::poses)
   int iterations = 0;        ///< Levenberg-Marquardt iterations over all passes
   int relinearisations = 0;  ///< gyro preintegration passes
   /// The model of T_g and T_a this result is of: kEstimate or kIdentity (kSelect chooses one).

@@ -62,30 +62,26 @@ std::vector<double> sampleIntervals(const std::vector<double>& stamps_s) {
   return dt;
 }
 
-GyroPreintegration preintegrateGyro(const std::vector<double>& stamps_s,
-                                    const std::vector<Eigen::Vector3d>& gyro_rad_s, double t_from_s,
-                                    double t_to_s, const Eigen::Matrix3d& T_g,
-                                    const Eigen::Vector3d& b_from, const Eigen::Vector3d& b_to) {
-  GyroPreintegration result;
-  result.theta0 = gyroModelVector(T_g, b_from, b_to);
-  const Eigen::Matrix3d T_g_inverse = T_g.inverse();
-  const std::vector<double> dt = sampleIntervals(stamps_s);
-  const double ramp_s = t_to_s - t_from_s;
-  const size_t n = std::min(stamps_s.size(), gyro_rad_s.size());
+namespace {
 
+/// Accumulates one step of rate `raw` (raw gyro, rad/s) held for dt at bias-ramp fraction s.
+struct Accumulator {
+  Eigen::Matrix3d T_g_inverse;
+  Eigen::Vector3d b_from, b_to;
   Eigen::Matrix3d delta_R = Eigen::Matrix3d::Identity();
   GyroPreintegrationJacobian J = GyroPreintegrationJacobian::Zero();
-  Eigen::Matrix3d step_R, step_Jr;
-  for (size_t i = 0; i < n; ++i) {
-    double s = ramp_s > 0.0 ? (stamps_s[i] - t_from_s) / ramp_s : 0.0;
-    s = std::clamp(s, 0.0, 1.0);
-    const Eigen::Vector3d bias = b_from + s * (b_to - b_from);
-    const Eigen::Vector3d rate = T_g_inverse * (gyro_rad_s[i] - bias);
-    const Eigen::Vector3d phi = rate * dt[i];
-    expAndRightJacobian(phi, &step_R, &step_Jr);
+  double duration_s = 0.0;
 
+  Eigen::Vector3d rateOf(const Eigen::Vector3d& raw, double s) const {
+    return T_g_inverse * (raw - (b_from + s * (b_to - b_from)));
+  }
+
+  void step(const Eigen::Vector3d& raw, double s, double dt) {
+    const Eigen::Vector3d rate = rateOf(raw, s);
+    Eigen::Matrix3d step_R, step_Jr;
+    expAndRightJacobian(rate * dt, &step_R, &step_Jr);
     // d rate / d T_g(r, c) = -T_g^-1 e_r rate_c; d rate / d b = -(1 - s or s) T_g^-1.
-    const Eigen::Matrix3d M = -dt[i] * step_Jr * T_g_inverse;
+    const Eigen::Matrix3d M = -dt * step_Jr * T_g_inverse;
     J = step_R.transpose() * J;
     for (int r = 0; r < 3; ++r) {
       for (int c = 0; c < 3; ++c) J.col(3 * r + c) += M.col(r) * rate(c);
@@ -93,11 +89,70 @@ GyroPreintegration preintegrateGyro(const std::vector<double>& stamps_s,
     J.block<3, 3>(0, 9) += (1.0 - s) * M;
     J.block<3, 3>(0, 12) += s * M;
     delta_R = delta_R * step_R;
-    result.duration_s += dt[i];
+    duration_s += dt;
   }
-  result.delta_R = projectToSO3(delta_R);
-  result.jacobian = J;
-  return result;
+
+  GyroPreintegration result(const GyroModelVector& theta0) const {
+    GyroPreintegration out;
+    out.theta0 = theta0;
+    out.delta_R = projectToSO3(delta_R);
+    out.jacobian = J;
+    out.duration_s = duration_s;
+    return out;
+  }
+};
+
+}  // namespace
+
+GyroPreintegration preintegrateGyro(const std::vector<double>& stamps_s,
+                                    const std::vector<Eigen::Vector3d>& gyro_rad_s, double t_from_s,
+                                    double t_to_s, const Eigen::Matrix3d& T_g,
+                                    const Eigen::Vector3d& b_from, const Eigen::Vector3d& b_to) {
+  Accumulator acc{T_g.inverse(), b_from, b_to};
+  const std::vector<double> dt = sampleIntervals(stamps_s);
+  const double ramp_s = t_to_s - t_from_s;
+  const size_t n = std::min(stamps_s.size(), gyro_rad_s.size());
+  for (size_t i = 0; i < n; ++i) {
+    double s = ramp_s > 0.0 ? (stamps_s[i] - t_from_s) / ramp_s : 0.0;
+    acc.step(gyro_rad_s[i], std::clamp(s, 0.0, 1.0), dt[i]);
+  }
+  return acc.result(gyroModelVector(T_g, b_from, b_to));
+}
+
+GyroPreintegration preintegrateGyroInterval(
+    const std::vector<double>& stamps_s, const std::vector<Eigen::Vector3d>& gyro_rad_s,
+    double t_from_s, double t_to_s, const Eigen::Matrix3d& T_g, const Eigen::Vector3d& b_from,
+    const Eigen::Vector3d& b_to, Eigen::Vector3d* rate_from, Eigen::Vector3d* rate_to) {
+  Accumulator acc{T_g.inverse(), b_from, b_to};
+  const GyroModelVector theta0 = gyroModelVector(T_g, b_from, b_to);
+  const size_t n = std::min(stamps_s.size(), gyro_rad_s.size());
+  const double ramp_s = t_to_s - t_from_s;
+  if (n < 2 || !(ramp_s > 0.0)) return acc.result(theta0);
+  const auto rawAt = [&](double t) -> Eigen::Vector3d {
+    size_t i = static_cast<size_t>(std::upper_bound(stamps_s.begin(), stamps_s.begin() + n, t) -
+                                   stamps_s.begin());
+    if (i == 0) return gyro_rad_s[0];
+    if (i >= n) return gyro_rad_s[n - 1];
+    const double w = (t - stamps_s[i - 1]) / (stamps_s[i] - stamps_s[i - 1]);
+    return (1.0 - w) * gyro_rad_s[i - 1] + w * gyro_rad_s[i];
+  };
+  // Sub-intervals between the interval's ends and the samples inside it; each is integrated at
+  // its midpoint's interpolated rate (exact for a rate linear between samples).
+  double t = t_from_s;
+  size_t i = static_cast<size_t>(
+      std::upper_bound(stamps_s.begin(), stamps_s.begin() + n, t_from_s) - stamps_s.begin());
+  while (t < t_to_s) {
+    const double next = i < n ? std::min(stamps_s[i], t_to_s) : t_to_s;
+    if (next > t) {
+      const double mid = 0.5 * (t + next);
+      acc.step(rawAt(mid), (mid - t_from_s) / ramp_s, next - t);
+    }
+    t = next;
+    ++i;
+  }
+  if (rate_from) *rate_from = acc.rateOf(rawAt(t_from_s), 0.0);
+  if (rate_to) *rate_to = acc.rateOf(rawAt(t_to_s), 1.0);
+  return acc.result(theta0);
 }
 
 Eigen::Matrix3d correctedDeltaR(const GyroPreintegration& preintegration,

@@ -15,6 +15,7 @@
 #include "camera_imu_alignment/estimation/gyro_preintegration.h"
 #include "camera_imu_alignment/estimation/joint_observability.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
+#include "joint_motion.h"
 #include "joint_state.h"
 
 namespace camera_imu_alignment {
@@ -24,20 +25,6 @@ namespace {
 /// (T_g entries, rad/s for the biases): the first-order preintegration error, ~change^2 x the
 /// rotation angle, is then ~1e-10 rad.
 constexpr double kRelinearisationThreshold = 1e-5;
-
-std::vector<GyroPreintegration> preintegrateAll(const JointProblem& problem,
-                                                const Eigen::Matrix3d& T_g,
-                                                const std::vector<Eigen::Vector3d>& biases) {
-  std::vector<GyroPreintegration> out;
-  out.reserve(problem.segments.size());
-  for (const GyroSegment& segment : problem.segments) {
-    out.push_back(preintegrateGyro(segment.stamps_s, segment.gyro_rad_s,
-                                   problem.poses[segment.from_pose].end_s,
-                                   problem.poses[segment.to_pose].start_s, T_g,
-                                   biases[segment.from_pose], biases[segment.to_pose]));
-  }
-  return out;
-}
 
 GyroExcitation excitationOf(const std::vector<GyroPreintegration>& segments) {
   GyroExcitation excitation;
@@ -50,10 +37,11 @@ GyroExcitation excitationOf(const std::vector<GyroPreintegration>& segments) {
   return excitation;
 }
 
-/// Largest change of the gyro model (T_g entries, biases) since the segments were preintegrated.
+/// Largest change of the gyro model (T_g entries, biases) since the segments were preintegrated;
+/// a change of the time offset counts as the rotation it makes at 1 rad/s.
 double gyroModelChange(const JointProblem& problem, const joint::State& state,
                        const std::vector<GyroPreintegration>& segments) {
-  double change = 0.0;
+  double change = std::abs(state.timeshift[0] - state.timeshift_0);
   const Eigen::Matrix3d T_g = state.gyroMatrix();
   for (size_t j = 0; j < segments.size(); ++j) {
     const GyroSegment& segment = problem.segments[j];
@@ -79,11 +67,19 @@ ceres::Solver::Options solverOptions(const JointSettings& settings) {
 }
 
 std::string summary(const JointProblem& problem, const JointResult& result) {
-  char buffer[256];
+  const auto rests = std::count_if(problem.poses.begin(), problem.poses.end(),
+                                   [](const JointPose& pose) { return pose.at_rest; });
+  const size_t nodes = problem.poses.size() - static_cast<size_t>(rests);
+  char motion[96] = "";
+  if (nodes > 0) {
+    std::snprintf(motion, sizeof(motion), ", %zu motion nodes, timeshift_cam_imu %.2f +- %.2f ms",
+                  nodes, 1e3 * result.timeshift_cam_imu_s, 1e3 * result.timeshift_sigma_s);
+  }
+  char buffer[320];
   std::snprintf(buffer, sizeof(buffer),
-                "joint estimate: %zu poses, %zu gyro segments, magnetometer %s; chi2/dof %.2f "
+                "joint estimate: %zu poses%s, %zu gyro segments, magnetometer %s; chi2/dof %.2f "
                 "(p %.3f); 1-sigma [%.4f %.4f %.4f] deg",
-                problem.poses.size(), problem.segments.size(),
+                static_cast<size_t>(rests), motion, problem.segments.size(),
                 result.intrinsics.magnetometer_used ? "used" : "not used",
                 result.dof > 0 ? result.chi2 / result.dof : 0.0, result.chi2_p_value,
                 result.std_dev_deg(0), result.std_dev_deg(1), result.std_dev_deg(2));
@@ -127,10 +123,12 @@ JointResult solveModel(const JointProblem& problem, const Eigen::Matrix3d& R_cam
 
   // Preintegrate with the ideal gyro and the rests' biases.
   const size_t n = problem.poses.size();
-  std::vector<Eigen::Vector3d> biases(n);
+  std::vector<Eigen::Vector3d> biases(n), rates_from, rates_to;
   for (size_t k = 0; k < n; ++k) biases[k] = problem.poses[k].gyro_mean_rad_s;
   std::vector<GyroPreintegration> gyro =
-      preintegrateAll(problem, Eigen::Matrix3d::Identity(), biases);
+      joint::preintegrateSegments(problem, Eigen::Matrix3d::Identity(), biases,
+                                  problem.timeshift_initial_s, &rates_from, &rates_to);
+  const bool motion = joint::hasMotionSegments(problem);
   if (settings.pin_unexcited_parameters && held == nullptr) {
     JointSettings free_settings = settings;
     free_settings.pin_unexcited_parameters = false;
@@ -147,6 +145,11 @@ JointResult solveModel(const JointProblem& problem, const Eigen::Matrix3d& R_cam
       held ? *held : decideObservability(problem, excitationOf(gyro), settings);
   joint::State state = joint::initialState(problem, R_cam_imu_initial, observability, settings);
   if (held) state.holdUnexcitedGyroColumns(observability);
+  if (motion) {  // the motion nodes' biases start from the rests'
+    for (size_t k = 0; k < n; ++k) biases[k] = state.gyroBias(static_cast<int>(k));
+    gyro = joint::preintegrateSegments(problem, Eigen::Matrix3d::Identity(), biases,
+                                       state.timeshift[0], &rates_from, &rates_to);
+  }
   joint::Whitening whitening;
   if (!joint::computeWhitening(problem, gyro, settings, &whitening, &result.message)) {
     return finish(result);
@@ -162,11 +165,14 @@ JointResult solveModel(const JointProblem& problem, const Eigen::Matrix3d& R_cam
         return finish(result);
       }
       for (size_t k = 0; k < n; ++k) biases[k] = state.gyroBias(static_cast<int>(k));
-      gyro = preintegrateAll(problem, T_g, biases);
+      gyro = joint::preintegrateSegments(problem, T_g, biases, state.timeshift[0], &rates_from,
+                                         &rates_to);
+      state.timeshift_0 = state.timeshift[0];
     }
     ceres::Problem ceres_problem;
-    const joint::BuiltProblem built = joint::buildProblem(problem, gyro, whitening, observability,
-                                                          settings, &state, &ceres_problem);
+    const joint::BuiltProblem built =
+        joint::buildProblem(problem, gyro, rates_from, rates_to, whitening, observability, settings,
+                            &state, &ceres_problem);
     ceres::Solver::Summary solver_summary;
     ceres::Solve(options, &ceres_problem, &solver_summary);
     result.iterations += static_cast<int>(solver_summary.iterations.size());
@@ -441,7 +447,15 @@ JointEstimator::JointEstimator(JointSettings settings) : settings_(std::move(set
 JointResult JointEstimator::solve(const JointProblem& problem,
                                   const Eigen::Matrix3d& R_cam_imu_initial) const {
   const auto start = std::chrono::steady_clock::now();
-  JointResult chosen = screenMagnetometer(problem, R_cam_imu_initial, settings_);
+  const std::string motion_error = joint::validateMotion(problem);
+  if (!motion_error.empty()) {
+    JointResult refused;
+    refused.message = motion_error;
+    return refused;
+  }
+  const joint::ExpandedProblem expanded = joint::expandMotion(problem, settings_);
+  JointResult chosen = screenMagnetometer(expanded.problem, R_cam_imu_initial, settings_);
+  joint::mapResultToCaller(expanded, &chosen);
   chosen.solve_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return chosen;

@@ -56,19 +56,38 @@ State initialState(const JointProblem& problem, const Eigen::Matrix3d& R_cam_imu
   state.delta.assign(n, {0.0, 0.0, 0.0});
   state.accel_bias.assign(n, {0.0, 0.0, 0.0});
   state.gyro_bias.resize(n);
+  // Motion nodes start from the rests' mean bias (zero without rests).
+  Eigen::Vector3d rest_bias = Eigen::Vector3d::Zero();
+  int rests = 0;
+  for (const JointPose& pose : problem.poses) {
+    if (!pose.at_rest) continue;
+    rest_bias += pose.gyro_mean_rad_s;
+    ++rests;
+  }
+  if (rests > 0) rest_bias /= rests;
   for (size_t k = 0; k < n; ++k) {
-    const Eigen::Vector3d& b = problem.poses[k].gyro_mean_rad_s;
+    const Eigen::Vector3d& b =
+        problem.poses[k].at_rest ? problem.poses[k].gyro_mean_rad_s : rest_bias;
     state.gyro_bias[k] = {b.x(), b.y(), b.z()};
   }
+  state.timeshift = {problem.timeshift_initial_s};
+  state.timeshift_0 = problem.timeshift_initial_s;
 
   // Up (the accelerometer's direction at rest) in the target frame, averaged over the poses.
   std::vector<Eigen::Matrix3d> R_target_imu(n);
   Eigen::Vector3d up_target = Eigen::Vector3d::Zero();
   for (size_t k = 0; k < n; ++k) {
     R_target_imu[k] = projectToSO3(problem.poses[k].R_target_cam) * state.R_cam_imu_0;
+    if (!problem.poses[k].at_rest) continue;  // a motion node: no accelerometer
     up_target += R_target_imu[k] * problem.poses[k].accel_mean_m_s2.normalized();
   }
-  if (!(up_target.norm() > 1e-6)) up_target = R_target_imu[0] * problem.poses[0].accel_mean_m_s2;
+  if (!(up_target.norm() > 1e-6)) {
+    for (size_t k = 0; k < n && !(up_target.norm() > 1e-6); ++k) {
+      if (problem.poses[k].at_rest) up_target = R_target_imu[k] * problem.poses[k].accel_mean_m_s2;
+    }
+  }
+  // Without rests W is a gauge: the target's -y (the wall board's up) or any axis.
+  if (!(up_target.norm() > 1e-6)) up_target = Eigen::Vector3d::UnitZ();
   Eigen::Matrix3d R_world_target =
       Eigen::Quaterniond::FromTwoVectors(up_target.normalized(), Eigen::Vector3d::UnitZ())
           .toRotationMatrix();

@@ -86,13 +86,22 @@ JointObservability decideObservability(const JointProblem& problem, const GyroEx
         "only)");
   }
   out.gyro_column_estimated = {gyro.has_segments, gyro.has_segments, gyro.has_segments};
-  out.accel_bias_estimated = true;
-  out.accel_matrix_estimated = true;
+  // Without rests the accelerometer is not used (it measures gravity plus the acceleration).
+  const bool rests = std::any_of(problem.poses.begin(), problem.poses.end(),
+                                 [](const JointPose& pose) { return pose.at_rest; });
+  out.accel_bias_estimated = rests;
+  out.accel_matrix_estimated = rests;
+  if (!rests) {
+    out.notes.push_back(
+        "no rests: the accelerometer is not used; R_cam_imu relative to its axes (the IMU frame) "
+        "rests on the gyro misalignment prior (gyro_cross_axis): a few rests of 1-2 s tie them");
+  }
 
   // The geometry, for the notes and the suggestion only.
   std::vector<Eigen::Vector3d> gravity_directions;
   Eigen::Vector3d mean_gravity = Eigen::Vector3d::Zero();
   for (const JointPose& pose : problem.poses) {
+    if (!pose.at_rest) continue;  // a motion node: no accelerometer
     gravity_directions.push_back(pose.accel_mean_m_s2.normalized());
     mean_gravity += gravity_directions.back();
   }

@@ -57,8 +57,13 @@ class Builder {
         pin_(settings.pin_unexcited_parameters),
         identity_matrices_(settings.imu_matrices == ImuMatrixModel::kIdentity) {}
 
-  BuiltProblem build(const std::vector<GyroPreintegration>& gyro) {
+  BuiltProblem build(const std::vector<GyroPreintegration>& gyro,
+                     const std::vector<Eigen::Vector3d>& rates_from,
+                     const std::vector<Eigen::Vector3d>& rates_to) {
     const size_t n = problem_.poses.size();
+    for (size_t k = 0; k < n; ++k) {
+      if (problem_.poses[k].at_rest) rests_.push_back(k);
+    }
     addBlock(state_.e_X.data(), 3);
     if (problem_.mount_change_pose >= 0) {
       addBlock(state_.e_X_after.data(), 3);
@@ -73,10 +78,12 @@ class Builder {
     if (!observability_.magnetometer_used) {
       ceres_.SetManifold(state_.e_T.data(), new ceres::SubsetManifold(3, {2}));
     }
+    // Without rests nothing sees the world frame: R_world_target is a gauge.
+    if (rests_.empty() && !observability_.magnetometer_used) holdBlock(state_.e_T.data());
     for (size_t k = 0; k < n; ++k) addBlock(state_.delta[k].data(), 3);
     addAccelerometer();
     if (observability_.magnetometer_used) addMagnetometer();
-    if (!problem_.segments.empty()) addGyro(gyro);
+    if (!problem_.segments.empty()) addGyro(gyro, rates_from, rates_to);
     return std::move(built_);
   }
 
@@ -116,8 +123,14 @@ class Builder {
   void addAccelerometer() {
     const size_t n = problem_.poses.size();
     addBlock(state_.accel_matrix.data(), 6);
-    for (size_t k = 0; k < n; ++k) addBlock(state_.accel_bias[k].data(), 3);
+    for (size_t k : rests_) addBlock(state_.accel_bias[k].data(), 3);
     for (size_t k = 0; k < n; ++k) {
+      if (!problem_.poses[k].at_rest) {  // a motion node: its camera prior only
+        auto* camera = new ceres::NormalPrior(whitening_.camera[k], ceres::Vector::Zero(3));
+        record(ceres_.AddResidualBlock(camera, loss_, state_.delta[k].data()), static_cast<int>(k),
+               -1, 3);
+        continue;
+      }
       const JointPose& pose = problem_.poses[k];
       auto* accel = new ceres::AutoDiffCostFunction<AccelResidual, 3, 3, 3, 3, 6, 3>(
           new AccelResidual{targetCam(k), cameraImu0(k), pose.accel_mean_m_s2, whitening_.accel[k],
@@ -131,6 +144,10 @@ class Builder {
              -1, 3);
     }
     const ImuModelPriors& p = settings_.priors;
+    if (rests_.empty()) {
+      holdBlock(state_.accel_matrix.data());  // no accelerometer data: nothing to estimate
+      return;
+    }
     if (identity_matrices_) {
       holdBlock(state_.accel_matrix.data());
     } else if (observability_.accel_matrix_estimated || !pin_) {
@@ -147,18 +164,19 @@ class Builder {
       // The prior holds the first pose's bias, the walk each next one's.
       record(ceres_.AddResidualBlock(
                  maskedPrior(3, {0, 1, 2}, std::vector<double>(3, p.accel_bias_m_s2)), nullptr,
-                 state_.accel_bias[0].data()),
+                 state_.accel_bias[rests_[0]].data()),
              -1, -1, 3);
-      for (size_t k = 0; k + 1 < n; ++k) {
-        const double dt = std::max(std::abs(restCentre(k + 1) - restCentre(k)), kMinWalkDt);
+      for (size_t i = 0; i + 1 < rests_.size(); ++i) {
+        const size_t k = rests_[i], l = rests_[i + 1];
+        const double dt = std::max(std::abs(restCentre(l) - restCentre(k)), kMinWalkDt);
         auto* walk = new ceres::AutoDiffCostFunction<BiasWalkResidual, 3, 3, 3>(
             new BiasWalkResidual{1.0 / (p.accel_bias_walk_m_s2_sqrt_s * std::sqrt(dt))});
         record(ceres_.AddResidualBlock(walk, nullptr, state_.accel_bias[k].data(),
-                                       state_.accel_bias[k + 1].data()),
-               static_cast<int>(k), static_cast<int>(k + 1), 3);
+                                       state_.accel_bias[l].data()),
+               static_cast<int>(k), static_cast<int>(l), 3);
       }
     } else {
-      for (size_t k = 0; k < n; ++k) holdBlock(state_.accel_bias[k].data());
+      for (size_t k : rests_) holdBlock(state_.accel_bias[k].data());
     }
   }
 
@@ -202,13 +220,16 @@ class Builder {
     }
   }
 
-  void addGyro(const std::vector<GyroPreintegration>& gyro) {
+  void addGyro(const std::vector<GyroPreintegration>& gyro,
+               const std::vector<Eigen::Vector3d>& rates_from,
+               const std::vector<Eigen::Vector3d>& rates_to) {
     const std::vector<bool> with_gyro = posesWithGyro(problem_);
     const size_t n = problem_.poses.size();
     addBlock(state_.gyro_matrix.data(), 9);
     for (size_t k = 0; k < n; ++k) {
       if (!with_gyro[k]) continue;
       addBlock(state_.gyro_bias[k].data(), 3);
+      if (!problem_.poses[k].at_rest) continue;  // a motion node: no rest mean
       auto* mean =
           new ceres::NormalPrior(whitening_.gyro_mean[k], problem_.poses[k].gyro_mean_rad_s);
       record(ceres_.AddResidualBlock(mean, nullptr, state_.gyro_bias[k].data()),
@@ -239,10 +260,25 @@ class Builder {
       const Eigen::Matrix3d camera_relative =
           projectToSO3(problem_.poses[from].R_target_cam).transpose() *
           projectToSO3(problem_.poses[to].R_target_cam);
+      GyroResidual residual{quaternionOf(camera_relative), quaternionOf(cameraImu0(from)),
+                            quaternionOf(gyro[j].delta_R), gyro[j].jacobian,
+                            theta0_minus_identity,         whitening_.gyro_relative[j]};
+      if (segment.interval) {
+        residual.rate_from = rates_from[j];
+        residual.rate_to = rates_to[j];
+        residual.timeshift0 = state_.timeshift_0;
+        addTimeshift();
+        auto* cost = new ceres::AutoDiffCostFunction<MotionGyroResidual, 3, 3, 3, 3, 9, 3, 3, 1>(
+            new MotionGyroResidual{residual});
+        record(ceres_.AddResidualBlock(cost, loss_, cameraImuIncrement(from),
+                                       state_.delta[from].data(), state_.delta[to].data(),
+                                       state_.gyro_matrix.data(), state_.gyro_bias[from].data(),
+                                       state_.gyro_bias[to].data(), state_.timeshift.data()),
+               from, to, 3);
+        continue;
+      }
       auto* cost = new ceres::AutoDiffCostFunction<GyroResidual, 3, 3, 3, 3, 9, 3, 3>(
-          new GyroResidual{quaternionOf(camera_relative), quaternionOf(cameraImu0(from)),
-                           quaternionOf(gyro[j].delta_R), gyro[j].jacobian, theta0_minus_identity,
-                           whitening_.gyro_relative[j]});
+          new GyroResidual(residual));
       record(
           ceres_.AddResidualBlock(cost, loss_, cameraImuIncrement(from), state_.delta[from].data(),
                                   state_.delta[to].data(), state_.gyro_matrix.data(),
@@ -278,6 +314,21 @@ class Builder {
            -1, -1, static_cast<int>(free_entries.size()));
   }
 
+  /// The time offset's block and its prior, once (motion nodes).
+  void addTimeshift() {
+    if (timeshift_added_) return;
+    timeshift_added_ = true;
+    addBlock(state_.timeshift.data(), 1);
+    ceres::Matrix A(1, 1);
+    A(0, 0) = 1.0 / problem_.timeshift_prior_sigma_s;
+    ceres::Vector b(1);
+    b(0) = problem_.timeshift_initial_s;
+    record(ceres_.AddResidualBlock(new ceres::NormalPrior(A, b), nullptr, state_.timeshift.data()),
+           -1, -1, 1);
+  }
+
+  std::vector<size_t> rests_;  // indices of the poses at rest (not motion nodes)
+  bool timeshift_added_ = false;
   const JointProblem& problem_;
   const Whitening& whitening_;
   const JointObservability& observability_;
@@ -293,10 +344,12 @@ class Builder {
 }  // namespace
 
 BuiltProblem buildProblem(const JointProblem& problem, const std::vector<GyroPreintegration>& gyro,
-                          const Whitening& whitening, const JointObservability& observability,
-                          const JointSettings& settings, State* state,
-                          ceres::Problem* ceres_problem) {
-  return Builder(problem, whitening, observability, settings, state, ceres_problem).build(gyro);
+                          const std::vector<Eigen::Vector3d>& rates_from,
+                          const std::vector<Eigen::Vector3d>& rates_to, const Whitening& whitening,
+                          const JointObservability& observability, const JointSettings& settings,
+                          State* state, ceres::Problem* ceres_problem) {
+  return Builder(problem, whitening, observability, settings, state, ceres_problem)
+      .build(gyro, rates_from, rates_to);
 }
 
 }  // namespace joint

@@ -119,6 +119,12 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
     bool is_delta = false;
     for (const auto& d : state.delta) is_delta = is_delta || block == d.data();
     if (is_delta) continue;
+    bool is_node_bias = false;  // motion nodes' gyro biases: many, and not reported
+    for (size_t k = 0; k < n; ++k) {
+      is_node_bias =
+          is_node_bias || (!problem.poses[k].at_rest && block == state.gyro_bias[k].data());
+    }
+    if (is_node_bias) continue;
     requested[block] = ceres_problem->ParameterBlockSize(block);
     pairs.emplace_back(block, block);
   }
@@ -171,10 +177,13 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
   const double unscale = 1.0 / std::sqrt(scale);
   in.accel_matrix_estimated = observability.accel_matrix_estimated && !identity &&
                               informedByTheData(accel_sigma * unscale, accel_prior);
+  int first_rest = 0;
+  while (first_rest + 1 < static_cast<int>(n) && !problem.poses[first_rest].at_rest) ++first_rest;
   const Eigen::VectorXd accel_bias_sigma =
-      blockSigma(*used, requested, state.accel_bias[0].data(),
-                 Eigen::Vector3d::Constant(p.accel_bias_m_s2), scale);
-  in.accel_bias_m_s2 = state.accelBias(0);
+      n == 0 ? Eigen::VectorXd(Eigen::Vector3d::Constant(p.accel_bias_m_s2))
+             : blockSigma(*used, requested, state.accel_bias[first_rest].data(),
+                          Eigen::Vector3d::Constant(p.accel_bias_m_s2), scale);
+  in.accel_bias_m_s2 = n == 0 ? Eigen::Vector3d::Zero() : state.accelBias(first_rest);
   in.accel_bias_sigma_m_s2 = accel_bias_sigma;
   in.accel_bias_per_pose_m_s2.clear();
   for (size_t k = 0; k < n; ++k) {
@@ -215,6 +224,13 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
   in.gyro_bias_sigma_rad_s =
       blockSigma(*used, requested, state.gyro_bias[first_pose].data(),
                  problem.poses[first_pose].gyro_mean_cov.diagonal().cwiseSqrt(), scale);
+
+  if (requested.count(state.timeshift.data()) > 0) {
+    result->timeshift_estimated = true;
+    result->timeshift_cam_imu_s = state.timeshift[0];
+    result->timeshift_sigma_s =
+        blockSigma(*used, requested, state.timeshift.data(), Eigen::VectorXd::Zero(1), scale)(0);
+  }
 
   in.magnetometer_used = observability.magnetometer_used;
   const Eigen::VectorXd soft_sigma =

@@ -159,9 +159,22 @@ struct GyroResidual {
     ceres::QuaternionProduct(a, b, ab);
   }
 
+  // Motion nodes (MotionGyroResidual): the calibrated body rates at the ends, rad/s, IMU frame.
+  Eigen::Vector3d rate_from = Eigen::Vector3d::Zero(), rate_to = Eigen::Vector3d::Zero();
+  double timeshift0 = 0;  // s, the preintegration's time offset
+
   template <typename T>
   bool operator()(const T* e_X, const T* delta_from, const T* delta_to, const T* gyro_matrix,
                   const T* bias_from, const T* bias_to, T* residual) const {
+    return evaluate<T, false>(e_X, delta_from, delta_to, gyro_matrix, bias_from, bias_to, nullptr,
+                              residual);
+  }
+
+  /// With kShifted, the ends at motion nodes move with the time offset: the gyro's rotation
+  /// becomes Exp(-rate_from dt) DeltaR Exp(rate_to dt), dt = timeshift - timeshift0.
+  template <typename T, bool kShifted>
+  bool evaluate(const T* e_X, const T* delta_from, const T* delta_to, const T* gyro_matrix,
+                const T* bias_from, const T* bias_to, const T* timeshift, T* residual) const {
     T q_e[4], q_X[4], q_X_inverse[4], q_from[4], q_to[4], a[4], b[4];
     const T q_X0_t[4] = {T(q_X0[0]), T(q_X0[1]), T(q_X0[2]), T(q_X0[3])};
     ceres::AngleAxisToQuaternion(e_X, q_e);
@@ -195,12 +208,35 @@ struct GyroResidual {
     q_correction[2] = -q_correction[2];
     q_correction[3] = -q_correction[3];
     multiply(q_correction, q_D0, q_gyro);
+    if constexpr (kShifted) {
+      // gyro_relative^T = Exp(-rate_to dt) Exp(-correction) DeltaR0^T Exp(rate_from dt)
+      const T dt = timeshift[0] - T(timeshift0);
+      const T to_angle[3] = {-T(rate_to(0)) * dt, -T(rate_to(1)) * dt, -T(rate_to(2)) * dt};
+      const T from_angle[3] = {T(rate_from(0)) * dt, T(rate_from(1)) * dt, T(rate_from(2)) * dt};
+      T q_end[4], q_start[4];
+      ceres::AngleAxisToQuaternion(to_angle, q_end);
+      ceres::AngleAxisToQuaternion(from_angle, q_start);
+      multiply(q_end, q_gyro, b);
+      multiply(b, q_start, q_gyro);
+    }
     multiply(q_gyro, q_imu_relative, a);
     Vector3<T> error;
     ceres::QuaternionToAngleAxis(a, error.data());
     Eigen::Map<Vector3<T>> out(residual);
     out = whitening.cast<T>() * error;
     return true;
+  }
+};
+
+/// GyroResidual of a segment with a motion node at an end: the time offset is a parameter too.
+struct MotionGyroResidual {
+  GyroResidual gyro;
+
+  template <typename T>
+  bool operator()(const T* e_X, const T* delta_from, const T* delta_to, const T* gyro_matrix,
+                  const T* bias_from, const T* bias_to, const T* timeshift, T* residual) const {
+    return gyro.evaluate<T, true>(e_X, delta_from, delta_to, gyro_matrix, bias_from, bias_to,
+                                  timeshift, residual);
   }
 };
 

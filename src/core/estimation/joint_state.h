@@ -36,6 +36,9 @@ struct State {
   std::array<double, 6> soft_iron{};              ///< S_m - I: [xx, yy, zz, xy, xz, yz]
   std::array<double, 3> hard_iron_ut{};
   std::array<double, 2> field_ut{};  ///< m_world = (0, field[0], field[1]) uT
+  /// timeshift_cam_imu (s) and the value the gyro was last preintegrated at (motion nodes).
+  std::array<double, 1> timeshift{};
+  double timeshift_0 = 0;
 
   Eigen::Matrix3d gyroMatrix() const;  ///< T_g
   Eigen::Vector3d gyroBias(int pose) const;
@@ -78,6 +81,19 @@ bool whiteningMatrix(const Eigen::Matrix3d& covariance, double floor_sigma,
 bool computeWhitening(const JointProblem& problem, const std::vector<GyroPreintegration>& segments,
                       const JointSettings& settings, Whitening* whitening, std::string* error);
 
+/// True when a segment has a motion node at an end (then the time offset is estimated).
+bool hasMotionSegments(const JointProblem& problem);
+
+/// Preintegrates every segment at T_g, the per-pose biases and the time offset (interval
+/// segments: the ends at motion nodes shifted by timeshift - problem.timeshift_initial_s).
+/// rates_from/rates_to: per segment, the calibrated body rate at each end (zero at a rest's end).
+std::vector<GyroPreintegration> preintegrateSegments(const JointProblem& problem,
+                                                     const Eigen::Matrix3d& T_g,
+                                                     const std::vector<Eigen::Vector3d>& biases,
+                                                     double timeshift,
+                                                     std::vector<Eigen::Vector3d>* rates_from,
+                                                     std::vector<Eigen::Vector3d>* rates_to);
+
 /// Poses that take part in a gyro segment (they get a gyro bias block).
 std::vector<bool> posesWithGyro(const JointProblem& problem);
 
@@ -89,9 +105,10 @@ State initialState(const JointProblem& problem, const Eigen::Matrix3d& R_cam_imu
 /// Adds every residual and prior of the problem at `state` (relinearised at its X0 and T0) and
 /// holds what `observability` does not estimate.
 BuiltProblem buildProblem(const JointProblem& problem, const std::vector<GyroPreintegration>& gyro,
-                          const Whitening& whitening, const JointObservability& observability,
-                          const JointSettings& settings, State* state,
-                          ceres::Problem* ceres_problem);
+                          const std::vector<Eigen::Vector3d>& rates_from,
+                          const std::vector<Eigen::Vector3d>& rates_to, const Whitening& whitening,
+                          const JointObservability& observability, const JointSettings& settings,
+                          State* state, ceres::Problem* ceres_problem);
 
 /// Covariances, chi2, per-pose norms, intrinsics and the parameter list into `result` (R_cam_imu
 /// and notes are set by the caller). False (with result->message) when the covariance fails.

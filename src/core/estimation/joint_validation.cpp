@@ -64,6 +64,7 @@ std::string validatePose(const JointPose& pose, size_t k, const JointSettings& s
   if (!usableCovariance(pose.cov_cam_rad2, s.camera_sigma_floor_rad)) {
     return name + ": cov_cam_rad2 is not a finite symmetric positive semi-definite matrix";
   }
+  if (!pose.at_rest) return "";  // a motion node: the camera only
   if (!pose.accel_mean_m_s2.allFinite()) return name + ": accelerometer mean is not finite";
   const double accel_norm = pose.accel_mean_m_s2.norm();
   if (accel_norm < 0.5 * s.gravity_m_s2 || accel_norm > 2.0 * s.gravity_m_s2) {
@@ -115,6 +116,10 @@ std::string validateSegment(const GyroSegment& segment, size_t j, const JointPro
     if (i > 0 && !(segment.stamps_s[i] > segment.stamps_s[i - 1])) {
       return name + ": stamps are not strictly increasing at sample " + std::to_string(i);
     }
+  }
+  if (segment.interval &&
+      (segment.stamps_s.front() > from.end_s || segment.stamps_s.back() < to.start_s)) {
+    return name + ": its samples do not cover the interval between its poses";
   }
   if (segment.stamps_s.back() - segment.stamps_s.front() > 3600.0) {
     return name + ": longer than an hour";
@@ -194,6 +199,13 @@ bool computeWhitening(const JointProblem& problem, const std::vector<GyroPreinte
   const double walk = settings.priors.gyro_bias_walk_rad_s_sqrt_s;
   for (size_t k = 0; k < n; ++k) {
     const JointPose& pose = problem.poses[k];
+    if (!pose.at_rest) {  // a motion node: the camera only
+      if (!whiteningMatrix(pose.cov_cam_rad2, settings.camera_sigma_floor_rad, &w->camera[k])) {
+        *error = "motion node " + std::to_string(k) + ": its camera covariance is not usable";
+        return false;
+      }
+      continue;
+    }
     // The bias at the rest's ends differs from its mean by the walk: variance walk^2 T / 3.
     const double rest_s = pose.end_s - pose.start_s;
     const Eigen::Matrix3d gyro_cov =
@@ -226,6 +238,45 @@ bool computeWhitening(const JointProblem& problem, const std::vector<GyroPreinte
     }
   }
   return true;
+}
+
+bool hasMotionSegments(const JointProblem& problem) {
+  for (const GyroSegment& segment : problem.segments) {
+    if (segment.interval) return true;
+  }
+  return false;
+}
+
+std::vector<GyroPreintegration> preintegrateSegments(const JointProblem& problem,
+                                                     const Eigen::Matrix3d& T_g,
+                                                     const std::vector<Eigen::Vector3d>& biases,
+                                                     double timeshift,
+                                                     std::vector<Eigen::Vector3d>* rates_from,
+                                                     std::vector<Eigen::Vector3d>* rates_to) {
+  std::vector<GyroPreintegration> out;
+  out.reserve(problem.segments.size());
+  rates_from->assign(problem.segments.size(), Eigen::Vector3d::Zero());
+  rates_to->assign(problem.segments.size(), Eigen::Vector3d::Zero());
+  const double shift = timeshift - problem.timeshift_initial_s;
+  for (size_t j = 0; j < problem.segments.size(); ++j) {
+    const GyroSegment& segment = problem.segments[j];
+    const JointPose& from = problem.poses[segment.from_pose];
+    const JointPose& to = problem.poses[segment.to_pose];
+    if (!segment.interval) {
+      out.push_back(preintegrateGyro(segment.stamps_s, segment.gyro_rad_s, from.end_s, to.start_s,
+                                     T_g, biases[segment.from_pose], biases[segment.to_pose]));
+      continue;
+    }
+    const double t_from = from.end_s + (from.at_rest ? 0.0 : shift);
+    const double t_to = to.start_s + (to.at_rest ? 0.0 : shift);
+    Eigen::Vector3d rate_from, rate_to;
+    out.push_back(preintegrateGyroInterval(segment.stamps_s, segment.gyro_rad_s, t_from, t_to, T_g,
+                                           biases[segment.from_pose], biases[segment.to_pose],
+                                           &rate_from, &rate_to));
+    if (!from.at_rest) (*rates_from)[j] = rate_from;
+    if (!to.at_rest) (*rates_to)[j] = rate_to;
+  }
+  return out;
 }
 
 std::vector<bool> posesWithGyro(const JointProblem& problem) {

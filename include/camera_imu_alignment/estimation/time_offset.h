@@ -1,0 +1,35 @@
+// Coarse camera-IMU time offset from continuous motion, before R_cam_imu is known.
+//
+// The angle the camera turns between consecutive frames equals the angle the IMU turns over the
+// same interval on its own clock, whatever R_cam_imu is (a rotation's angle does not depend on the
+// frame it is written in). The search shifts the frames' intervals by each candidate offset and
+// compares the camera's angles with |integral of the gyro| over the shifted intervals (least
+// squares; the gyro's scale error of a few percent and its bias of a few deg/s barely move the
+// minimum). Kalibr's sign: t_imu = t_cam + timeshift_cam_imu_s.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "camera_imu_alignment/estimation/joint_types.h"
+
+namespace camera_imu_alignment {
+
+struct TimeshiftSearch {
+  bool ok = false;
+  double timeshift_cam_imu_s = 0;  ///< t_imu = t_cam + timeshift (s)
+  /// RMS difference (rad) of the camera's and the gyro's angles per frame interval at the minimum.
+  double rms_angle_difference_rad = 0;
+  int intervals = 0;    ///< frame intervals compared
+  std::string message;  ///< why not, when !ok (an offset beyond the range names the range)
+};
+
+/// Searches timeshift_cam_imu_s in [-range_s, range_s] (1 ms steps, then a parabola through the
+/// best three). Frames further apart than max_interval_s are not compared (the target was out of
+/// view). Needs frames in stamp order, a gyro stream covering them, and rotation: !ok with a
+/// message when fewer than 20 intervals turn by more than 0.5 deg, or when the best offset is at an
+/// end of the range (the offset is larger than the range).
+TimeshiftSearch coarseTimeshift(const std::vector<MotionFrame>& frames, const GyroStream& gyro,
+                                double range_s, double max_interval_s = 0.2);
+
+}  // namespace camera_imu_alignment
