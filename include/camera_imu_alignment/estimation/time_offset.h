@@ -29,6 +29,13 @@ struct TimeshiftSearch {
 /// view). Needs frames in stamp order, a gyro stream covering them, and rotation: !ok with a
 /// message when fewer than 20 intervals turn by more than 0.5 deg, or when the best offset is at an
 /// end of the range (the offset is larger than the range).
+/// The gyro's white noise density (rad/s/sqrt(Hz)) measured on a stream in motion: the second
+/// difference of consecutive samples removes a smooth motion (its residue is ~ the angular
+/// acceleration's rate of change x dt^2) and leaves 6 sigma^2 of white noise; the median of the
+/// absolute values (robust to jerks) gives sigma, sigma / sqrt(rate) the density. 0 for fewer than
+/// 10 samples.
+double gyroNoiseDensityOf(const GyroStream& gyro);
+
 TimeshiftSearch coarseTimeshift(const std::vector<MotionFrame>& frames, const GyroStream& gyro,
                                 double range_s, double max_interval_s = 0.2);
 

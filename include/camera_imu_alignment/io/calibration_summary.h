@@ -60,7 +60,10 @@ std::string formatSummary(const ReportInput& input);
 ///  - VINS-Mono / VINS-Fusion: extrinsicRotation (opencv-matrix, R_imu_cam: camera to body/IMU),
 ///  - `rosrun tf2_ros static_transform_publisher 0 0 0 qx qy qz qw <camera_frame> <imu_frame>`
 ///    (parent camera, child IMU: the transform maps IMU-frame points into the camera frame).
+/// With timeshift_cam_imu_s (estimated from motion) Kalibr's block carries it as
+/// timeshift_cam_imu (t_imu = t_cam + timeshift_cam_imu).
 std::string exportBlocks(const Eigen::Matrix3d& R_cam_imu, const std::string& camera_frame,
-                         const std::string& imu_frame);
+                         const std::string& imu_frame,
+                         std::optional<double> timeshift_cam_imu_s = std::nullopt);
 
 }  // namespace camera_imu_alignment

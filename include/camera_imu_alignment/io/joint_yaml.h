@@ -9,6 +9,9 @@
 
 namespace camera_imu_alignment {
 
+/// Which data the estimate used: "rests", "motion" (motion nodes only) or "both".
+const char* dataUsed(const JointResult& joint);
+
 /// The two blocks as YAML text (top level, no trailing blank line).
 std::string jointToYaml(const JointResult& joint);
 

@@ -47,6 +47,11 @@ struct GateOutcome {
 ///     remount.level);
 ///   min_change_deg: a change smaller than that is not re-broadcast (refines_broadcast when it is
 ///     more precise).
+/// A joint estimate with at least this many motion nodes (about 5 s of motion at the default
+/// node spacing) stands in for min_poses: a recording without rests has no poses to count, and
+/// its statistical gates (consistency, 1-sigma) decide.
+constexpr int kMinMotionNodes = 50;
+
 GateOutcome judgeEstimate(const AlignmentResult& result, std::size_t window_poses,
                           const OnlineSettings& settings,
                           const std::optional<BroadcastEstimate>& broadcast, bool fresh_start);

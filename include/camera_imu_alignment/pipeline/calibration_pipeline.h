@@ -92,8 +92,15 @@ struct PipelineSettings {
   double frame_margin_s = 0.15;        ///< see "Time offsets" above
   double max_camera_spread_deg = 0.5;  ///< camera orientation scatter within a pose
   double max_gyro_span_s = 120.0;      ///< longer motion between poses breaks the gyro chain
-  double frame_queue_s = 3.0;          ///< frames older than the IMU by more are dropped (no IMU)
-  double accel_weight = 0.9;           ///< attitudeFromAccelMag
+  /// Continuous motion: camera frames outside the rests (the target seen, or a camera_pose) and
+  /// the raw gyro are kept this long (s) for the joint estimate's motion nodes; 0: rests only.
+  double motion_window_s = 120.0;
+  /// Frames during motion closer than this (s) to the last one used are skipped (detection cost).
+  double motion_frame_interval_s = 0.05;
+  /// The camera-IMU time offset (timeshift_cam_imu) is searched within +- this (s).
+  double max_timeshift_s = 0.1;
+  double frame_queue_s = 3.0;  ///< frames older than the IMU by more are dropped (no IMU)
+  double accel_weight = 0.9;   ///< attitudeFromAccelMag
   /// Returns an empty string when usable, else the first unusable setting, named by its key in
   /// config/default.yaml.
   std::string validate() const;
@@ -227,6 +234,9 @@ class CalibrationPipeline : public SampleSink {
   std::uint64_t magneticSamples() const;
   std::uint64_t frames() const;
   std::uint64_t framesDetected() const;  ///< frames on which detection ran
+  /// Frames during motion with a camera orientation (the joint estimate's motion frames), since
+  /// the start or the last reset.
+  std::uint64_t motionFrames() const;
   /// Detection ran on at least this many frames before targetNotFoundDiagnosis() speaks.
   static constexpr std::uint64_t kFramesForTargetDiagnosis = 3;
   /// "" unless the target was never found in kFramesForTargetDiagnosis or more frames at rest;

@@ -85,6 +85,13 @@ const std::vector<Key>& keys() {
                      "a longer gap between IMU samples ends a rest and the gyro chain"),
       number<double>("max_gyro_span_s", CIA_MEMBER(max_gyro_span_s), positive, "s",
                      "longer motion between two rests breaks the gyro chain"),
+      number<double>("motion_window_s", CIA_MEMBER(motion_window_s), non_negative, "s",
+                     "camera frames and gyro during motion kept for the joint estimate; 0: rests "
+                     "only"),
+      number<double>("motion_frame_interval_s", CIA_MEMBER(motion_frame_interval_s), non_negative,
+                     "s", "frames during motion closer than this to the last one used are skipped"),
+      number<double>("max_timeshift_s", CIA_MEMBER(max_timeshift_s), positive, "s",
+                     "the camera-IMU time offset is searched within +- this"),
       // How R_cam_imu is estimated.
       wordKey<PipelineSettings>(
           "imu_orientation", CIA_MEMBER(imu_orientation),

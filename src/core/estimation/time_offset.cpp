@@ -47,6 +47,26 @@ class GyroIntegral {
 
 }  // namespace
 
+double gyroNoiseDensityOf(const GyroStream& gyro) {
+  const size_t n = std::min(gyro.stamps_s.size(), gyro.gyro_rad_s.size());
+  if (n < 10) return 0.0;
+  std::vector<double> absolute, intervals;
+  for (size_t i = 1; i + 1 < n; ++i) {
+    const Eigen::Vector3d second =
+        gyro.gyro_rad_s[i + 1] - 2.0 * gyro.gyro_rad_s[i] + gyro.gyro_rad_s[i - 1];
+    for (int a = 0; a < 3; ++a) absolute.push_back(std::abs(second(a)));
+    intervals.push_back(gyro.stamps_s[i + 1] - gyro.stamps_s[i]);
+  }
+  const auto median = [](std::vector<double>* v) {
+    std::nth_element(v->begin(), v->begin() + v->size() / 2, v->end());
+    return (*v)[v->size() / 2];
+  };
+  // |N(0, s^2)| has median 0.6745 s; the second difference has s^2 = 6 sigma^2.
+  const double sigma = median(&absolute) / 0.6745 / std::sqrt(6.0);
+  const double dt = median(&intervals);
+  return dt > 0.0 ? sigma * std::sqrt(dt) : 0.0;
+}
+
 TimeshiftSearch coarseTimeshift(const std::vector<MotionFrame>& frames, const GyroStream& gyro,
                                 double range_s, double max_interval_s) {
   TimeshiftSearch out;

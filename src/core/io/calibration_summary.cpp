@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 
 #include "camera_imu_alignment/io/joint_yaml.h"
@@ -34,12 +35,16 @@ std::string transformRows(const Eigen::MatrixBase<Derived>& R, const std::string
   return rows + indent + "- [0.0, 0.0, 0.0, 1.0]\n";
 }
 
-std::string kalibrBlock(const Eigen::Matrix3d& R_cam_imu) {
-  return "# Kalibr camchain-imucam.yaml: T_cam_imu maps IMU-frame points into the camera frame\n"
-         "# (p_cam = T_cam_imu * p_imu); rotation only: translation not estimated (0 here).\n"
-         "cam0:\n"
-         "  T_cam_imu:\n" +
-         transformRows(R_cam_imu, "  ");
+std::string kalibrBlock(const Eigen::Matrix3d& R_cam_imu, std::optional<double> timeshift_s) {
+  std::string block =
+      "# Kalibr camchain-imucam.yaml: T_cam_imu maps IMU-frame points into the camera frame\n"
+      "# (p_cam = T_cam_imu * p_imu); rotation only: translation not estimated (0 here).\n"
+      "cam0:\n"
+      "  T_cam_imu:\n" +
+      transformRows(R_cam_imu, "  ");
+  if (timeshift_s)
+    block += "  timeshift_cam_imu: " + exact(*timeshift_s) + "  # t_imu = t_cam + this\n";
+  return block;
 }
 
 std::string openVinsBlock(const Eigen::Matrix3d& R_cam_imu) {
@@ -97,6 +102,17 @@ void writeJoint(std::ostream& out, const JointResult& j) {
     return;
   }
   out << "joint estimate: " << jointConsistencyText(j) << ", " << j.iterations << " iteration(s)\n";
+  out << "  data used: " << dataUsed(j) << " (" << j.rests_used << " rest(s), " << j.motion_nodes
+      << " motion node(s))\n";
+  if (j.timeshift_estimated) {
+    const std::ios::fmtflags flags = out.flags();
+    const std::streamsize precision = out.precision();
+    out << "  camera-IMU time offset timeshift_cam_imu_s: " << std::fixed << std::setprecision(5)
+        << j.timeshift_cam_imu_s << " s +- " << j.timeshift_sigma_s
+        << " (1-sigma; t_imu = t_cam + timeshift)\n";
+    out.flags(flags);
+    out.precision(precision);
+  }
   const ImuIntrinsics& i = j.intrinsics;
   // Every parameter is estimated with its prior; "estimated": the data determined it.
   const auto state = [](bool estimated) {
@@ -171,9 +187,9 @@ void writePoseFigures(std::ostream& out, const ReportFigures& figures) {
 }  // namespace
 
 std::string exportBlocks(const Eigen::Matrix3d& R_cam_imu, const std::string& camera_frame,
-                         const std::string& imu_frame) {
-  return kalibrBlock(R_cam_imu) + "\n" + openVinsBlock(R_cam_imu) + "\n" + vinsBlock(R_cam_imu) +
-         "\n" + tfBlock(R_cam_imu, camera_frame, imu_frame);
+                         const std::string& imu_frame, std::optional<double> timeshift_cam_imu_s) {
+  return kalibrBlock(R_cam_imu, timeshift_cam_imu_s) + "\n" + openVinsBlock(R_cam_imu) + "\n" +
+         vinsBlock(R_cam_imu) + "\n" + tfBlock(R_cam_imu, camera_frame, imu_frame);
 }
 
 std::string formatSummary(const ReportInput& input) {
@@ -194,7 +210,11 @@ std::string formatSummary(const ReportInput& input) {
     out << "# WARNING: status '" << toString(input.result.status)
         << "': the blocks below hold the best guess only, do not use them as a calibration.\n";
   }
-  out << exportBlocks(input.result.R_cam_imu, input.camera_frame, input.imu_frame);
+  const std::optional<JointResult>& joint = input.result.joint;
+  out << exportBlocks(input.result.R_cam_imu, input.camera_frame, input.imu_frame,
+                      joint && joint->ok && joint->timeshift_estimated
+                          ? std::optional<double>(joint->timeshift_cam_imu_s)
+                          : std::nullopt);
   return out.str();
 }
 

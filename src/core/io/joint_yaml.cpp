@@ -39,6 +39,11 @@ const char* boolText(bool b) { return b ? "true" : "false"; }
 
 }  // namespace
 
+const char* dataUsed(const JointResult& j) {
+  if (j.motion_nodes > 0) return j.rests_used > 0 ? "both" : "motion";
+  return "rests";
+}
+
 std::string jointToYaml(const JointResult& j) {
   std::ostringstream out;
   out << std::setprecision(9);
@@ -52,6 +57,14 @@ std::string jointToYaml(const JointResult& j) {
   out << "  consistency_level: " << j.consistency_level << "\n";
   out << "  covariance_scale: " << j.covariance_scale << "  # chi2/dof when > 1, applied\n";
   out << "  std_dev_deg: " << flow(j.std_dev_deg) << "  # 1-sigma about the camera x, y, z axes\n";
+  out << "  data_used: " << dataUsed(j) << "  # rests, motion or both\n";
+  out << "  rests: " << j.rests_used << "\n";
+  out << "  motion_nodes: " << j.motion_nodes << "\n";
+  if (j.timeshift_estimated) {
+    out << "  timeshift_cam_imu_s: " << j.timeshift_cam_imu_s
+        << "  # Kalibr's sign: t_imu = t_cam + timeshift_cam_imu_s\n";
+    out << "  timeshift_cam_imu_sigma_s: " << j.timeshift_sigma_s << "\n";
+  }
   out << "  iterations: " << j.iterations << "\n";
   out << "  solve_time_s: " << j.solve_time_s << "\n";
   out << "  pose_residual_norm: "

@@ -66,6 +66,12 @@ std::string resultToYaml(const AlignmentResult& r, const ResultMetadata& meta) {
         << ", 0.0]\n";
   }
   out << "  - [0.0, 0.0, 0.0, 1.0]\n" << std::setprecision(6);
+  if (r.joint && r.joint->ok && r.joint->timeshift_estimated) {
+    out << std::setprecision(9) << "timeshift_cam_imu_s: " << r.joint->timeshift_cam_imu_s
+        << "  # Kalibr's timeshift_cam_imu: t_imu = t_cam + timeshift_cam_imu_s\n"
+        << "timeshift_cam_imu_sigma_s: " << r.joint->timeshift_sigma_s << "  # 1-sigma\n"
+        << std::setprecision(6);
+  }
   writeRotation(out, "R_imu_cam", "p_imu = R_imu_cam * p_cam (OpenVINS / VINS-Mono direction)",
                 R.transpose());
   out << "quality:\n";

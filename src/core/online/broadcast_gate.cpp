@@ -92,7 +92,8 @@ GateOutcome judgeEstimate(const AlignmentResult& r, std::size_t window_poses,
     why << r.message;
   } else if (!r.R_cam_imu.allFinite() || !r.quality.std_dev_deg.allFinite()) {
     why << "estimate or 1-sigma not finite";  // never reaches the tf or a file
-  } else if (window_poses < static_cast<std::size_t>(settings.min_poses)) {
+  } else if (window_poses < static_cast<std::size_t>(settings.min_poses) &&
+             !(joint && r.joint->motion_nodes >= kMinMotionNodes)) {
     why << window_poses << " poses in the window, min_poses is " << settings.min_poses;
   } else if (joint && !r.joint->ok) {
     why << "the joint estimate failed: " << r.joint->message;

@@ -76,6 +76,9 @@ struct OnlineCalibrator::Impl {
   void onPoseRejected(const RejectedPose& rejected);
   void checkPairRemount(const StationaryPose& pose);
   void requestSolve();
+  /// Continuous motion: a solve every kMotionFramesPerSolve new motion frames.
+  void onMotionFrames();
+  std::uint64_t motion_frames_solved = 0;  ///< pipeline->motionFrames() at the last such solve
   void poll();
   void apply(SolveOutput output);
   void applyRemount(const SolveOutput& output);
@@ -110,6 +113,7 @@ void OnlineCalibrator::Impl::checkClock(double stamp_s, InputStream stream) {
   const double jump_s = clock.update(toString(stream), stamp_s);
   if (jump_s <= 0.0) return;
   pipeline->reset();
+  motion_frames_solved = 0;
   ++generation;
   inconsistent_poses = 0;
   last_pose.reset();
@@ -186,6 +190,14 @@ void OnlineCalibrator::Impl::requestSolve() {
   } else {
     apply(runSolveJob(std::move(job), pipeline_settings, settings));
   }
+}
+
+void OnlineCalibrator::Impl::onMotionFrames() {
+  constexpr std::uint64_t kMotionFramesPerSolve = 100;  // 5 s at 20 Hz
+  const std::uint64_t frames = pipeline->motionFrames();
+  if (frames < motion_frames_solved + kMotionFramesPerSolve) return;
+  motion_frames_solved = frames;
+  requestSolve();
 }
 
 void OnlineCalibrator::Impl::poll() {
@@ -327,6 +339,7 @@ void OnlineCalibrator::addFrame(const CameraFrame& frame) {
   impl_->checkClock(frame.stamp_s,
                     frame.R_target_cam ? InputStream::kCameraPose : InputStream::kImage);
   impl_->pipeline->addFrame(frame);
+  impl_->onMotionFrames();
   impl_->refreshWaiting();
   impl_->poll();
 }
@@ -395,6 +408,7 @@ void OnlineCalibrator::reset() {
   if (impl_->worker) impl_->worker->waitIdle();
   impl_->poll();
   impl_->pipeline->reset();
+  impl_->motion_frames_solved = 0;
   ++impl_->generation;
   impl_->last_estimate.reset();
   impl_->last_pose.reset();

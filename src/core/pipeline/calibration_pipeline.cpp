@@ -151,6 +151,11 @@ void CalibrationPipeline::addImu(const ImuSample& sample) {
   // still counts for frames taken inside it.
   s.processFrames(false);
   s.imu_buffer.push_back(sample);
+  if (s.settings.motion_window_s > 0.0) {
+    s.motion_gyro.emplace_back(sample.stamp_s, sample.gyro_rad_s);
+    const double keep_s = s.settings.motion_window_s + s.settings.max_timeshift_s + 1.0;
+    while (s.motion_gyro.front().first < sample.stamp_s - keep_s) s.motion_gyro.pop_front();
+  }
   while (!s.imu_buffer.empty() &&
          s.imu_buffer.front().stamp_s < sample.stamp_s - s.settings.max_gyro_span_s) {
     s.imu_buffer.pop_front();
@@ -235,7 +240,11 @@ void CalibrationPipeline::Impl::processFrames(bool flush) {
     const std::optional<double> rest_since = stationary.restSince();
     const bool at_rest = stationary.atRest() && rest_since &&
                          frame.stamp_s >= *rest_since + settle && frame.stamp_s <= last_imu_stamp;
-    if (at_rest) processFrame(frame);
+    if (at_rest) {
+      processFrame(frame);
+    } else if (settings.motion_window_s > 0.0 && frame.stamp_s <= last_imu_stamp) {
+      processMotionFrame(frame);
+    }
     frame_queue.pop_front();
   }
 }
@@ -300,12 +309,49 @@ void CalibrationPipeline::Impl::processFrame(const CameraFrame& frame) {
   detections.push_back({frame.stamp_s, *pose});
 }
 
+void CalibrationPipeline::Impl::processMotionFrame(const CameraFrame& frame) {
+  if (frame.stamp_s - last_motion_frame_stamp < settings.motion_frame_interval_s) return;
+  MotionFrame motion;
+  motion.stamp_s = frame.stamp_s;
+  if (frame.R_target_cam) {
+    motion.R_target_cam = *frame.R_target_cam;
+    // A given orientation states no covariance: a motion-capture or PnP class 1-sigma; the joint
+    // estimate scales its covariance by chi2/dof when the data say it is larger.
+    const double sigma_rad = kGivenOrientationSigmaDeg * 3.14159265358979323846 / 180.0;
+    motion.cov_cam_rad2 = sigma_rad * sigma_rad * Eigen::Matrix3d::Identity();
+  } else {
+    if (!intrinsics || frame.mono8.cols != intrinsics->width ||
+        frame.mono8.rows != intrinsics->height) {
+      return;  // counted and said by the rests' frames
+    }
+    ++num_detected;
+    const Eigen::Matrix3d* hint =
+        motion_frames.empty() ? nullptr : &motion_frames.back().R_target_cam;
+    TargetObservation observation;
+    if (!detector.detect(frame.mono8, &observation, hint)) return;  // out of view or blurred
+    std::string why;
+    const auto pose = estimateCameraPose(observation, target, *intrinsics, settings.pose, &why);
+    if (!pose) return;  // a poor fit (e.g. motion blur): dropped by the PnP checks
+    motion.R_target_cam = pose->R_target_cam;
+    motion.cov_cam_rad2 = pose->cov_rotation_rad2;
+  }
+  last_motion_frame_stamp = frame.stamp_s;
+  motion_frames.push_back(motion);
+  ++motion_frames_total;
+  while (!motion_frames.empty() &&
+         motion_frames.front().stamp_s < frame.stamp_s - settings.motion_window_s) {
+    motion_frames.pop_front();
+  }
+}
+
 void CalibrationPipeline::finish() {
   impl_->processFrames(true);
   if (auto segment = impl_->stationary.flush()) impl_->onSegment(*segment);
 }
 
 WindowSnapshot CalibrationPipeline::snapshot() const { return impl_->snapshot(); }
+
+std::uint64_t CalibrationPipeline::motionFrames() const { return impl_->motion_frames_total; }
 
 ImuOrientationSource CalibrationPipeline::imuOrientationSource() const {
   return impl_->settings.imu_orientation;

@@ -14,6 +14,9 @@
 
 namespace camera_imu_alignment {
 
+/// 1-sigma (deg per axis) assumed for a camera orientation given without covariance (camera_pose).
+constexpr double kGivenOrientationSigmaDeg = 0.05;
+
 /// Camera pose of one frame taken at rest.
 struct FrameDetection {
   double stamp_s = 0.0;
@@ -27,6 +30,12 @@ struct SegmentField {
   Eigen::Matrix3d mean_cov_t2 = Eigen::Matrix3d::Zero();  ///< covariance of the mean (scatter / N)
   double scatter_deg = 0.0;
 };
+
+/// Before a solve with motion frames (motion_assembly.cpp): the time offset's coarse value and the
+/// gyro's noise into the joint problem, and pairs of motion nodes when the window has no rest
+/// pairs (for the pair solvers and the joint estimate's start). The motion frames are dropped
+/// when the offset cannot be found; returns what was done or why not, for the result's message.
+std::string prepareMotion(const PipelineSettings& settings, WindowSnapshot* window);
 
 struct CalibrationPipeline::Impl {
   Impl(const TargetDescription& target, const PipelineSettings& settings,
@@ -78,6 +87,12 @@ struct CalibrationPipeline::Impl {
   std::optional<GyroSegment> joint_gyro_pending;
   double last_gyro_noise_density = 0.0;  ///< of the previous rest (rad/s/sqrt(Hz))
 
+  // --- continuous motion (settings.motion_window_s > 0)
+  std::deque<MotionFrame> motion_frames;  ///< frames outside the rests with a camera orientation
+  std::deque<std::pair<double, Eigen::Vector3d>> motion_gyro;  ///< raw gyro (stamp, rad/s)
+  double last_motion_frame_stamp = -std::numeric_limits<double>::infinity();
+  std::uint64_t motion_frames_total = 0;
+
   std::size_t poses_total = 0, rests_total = 0;
   std::uint64_t imu_gaps = 0;  ///< IMU stamp gaps longer than settings.stationary.max_gap_s
 
@@ -87,6 +102,11 @@ struct CalibrationPipeline::Impl {
   /// Processes queued frames whose rest/motion status the IMU has settled.
   void processFrames(bool flush);
   void processFrame(const CameraFrame& frame);
+  /// A frame during motion: its camera orientation (detection and PnP, or the given one) joins
+  /// motion_frames.
+  void processMotionFrame(const CameraFrame& frame);
+  /// The motion frames and gyro for the joint problem: frames from `from_s` on.
+  void addMotion(double from_s, JointProblem* problem) const;
   /// A stationary segment ended: build the pose (pose_assembly.cpp) in these steps.
   void onSegment(const StationarySegment& segment);
   /// The rest's mean field: sets magnetometer_usable / R_world_imu_accel_mag or the note why not.

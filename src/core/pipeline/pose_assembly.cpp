@@ -353,18 +353,30 @@ WindowSnapshot CalibrationPipeline::Impl::snapshot() const {
   out.pairs = window.pairs();
   if (usesJointEstimate(settings.imu_orientation)) out.joint = window.problem();
   // The paper's sensors: the IMU orientation from gravity and the field alone, the gyro left out.
-  if (settings.imu_orientation == ImuOrientationSource::kMagnetometer) out.joint.segments.clear();
+  if (settings.imu_orientation == ImuOrientationSource::kMagnetometer) {
+    out.joint.segments.clear();
+  } else if (usesJointEstimate(settings.imu_orientation) && settings.motion_window_s > 0.0) {
+    // Motion since the window's first rest (all of it without rests).
+    const std::vector<StationaryPose> window_poses = window.poses();
+    addMotion(window_poses.empty() ? -1e300 : window_poses.front().start_s, &out.joint);
+  }
   for (const StationaryPose& pose : window.poses()) out.pose_indices.push_back(pose.index);
   return out;
 }
 
-AlignmentResult solveWindow(const WindowSnapshot& window, const PipelineSettings& settings) {
+AlignmentResult solveWindow(const WindowSnapshot& window_in, const PipelineSettings& settings) {
+  WindowSnapshot window = window_in;
+  std::string motion_note;
+  if (!window.joint.motion_frames.empty()) {
+    motion_note = prepareMotion(settings, &window);  // the time offset's start, motion pairs
+  }
   const RotationPairs& pairs = window.pairs;
   if (pairs.empty()) {
     AlignmentResult result;
     result.status = SolveStatus::kBadInput;
     result.message = "no pairs yet: " + std::to_string(window.pose_indices.size()) +
-                     " stationary pose(s) in the window, at least 2 of one group needed";
+                     " stationary pose(s) in the window, at least 2 of one group needed" +
+                     (motion_note.empty() ? "" : "; motion: " + motion_note);
     return result;
   }
   AlignmentResult result = solveAlignment(pairs, settings.solver);
@@ -382,8 +394,14 @@ AlignmentResult solveWindow(const WindowSnapshot& window, const PipelineSettings
     result.R_cam_imu = joint.R_cam_imu;
     result.quality.std_dev_deg = joint.std_dev_deg;
     result.quality.covariance_rad2 = joint.covariance_rad2;  // the two stay one estimate's
+    const std::string motion = joint.motion_nodes > 0
+                                   ? " and " + std::to_string(joint.motion_nodes) +
+                                         " motion nodes (timeshift_cam_imu " +
+                                         fmt(1e3 * joint.timeshift_cam_imu_s, 2) + " +- " +
+                                         fmt(1e3 * joint.timeshift_sigma_s, 2) + " ms)"
+                                   : "";
     result.message = "joint estimate" + sensors + " over " +
-                     std::to_string(window.joint.poses.size()) + " poses: chi2/dof " +
+                     std::to_string(window.joint.poses.size()) + " poses" + motion + ": chi2/dof " +
                      fmt(joint.dof > 0 ? joint.chi2 / joint.dof : 0.0) + ", 1-sigma [" +
                      fmt(joint.std_dev_deg.x(), 4) + " " + fmt(joint.std_dev_deg.y(), 4) + " " +
                      fmt(joint.std_dev_deg.z(), 4) + "] deg; pairs: " + result.message;

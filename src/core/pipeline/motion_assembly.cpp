@@ -1,0 +1,85 @@
+// Continuous motion for the joint estimate: the frames and gyro the pipeline kept during motion
+// become the joint problem's motion frames (estimation/joint_types.h), with the time offset's
+// coarse value; without rests, pairs of motion nodes start the solve.
+#include <cmath>
+#include <cstdio>
+
+#include "calibration_pipeline_impl.h"
+#include "camera_imu_alignment/estimation/gyro_preintegration.h"
+#include "camera_imu_alignment/estimation/time_offset.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
+
+namespace camera_imu_alignment {
+namespace {
+
+/// Motion pairs for the pair solvers: frames at least this far apart (s).
+constexpr double kPairSpacingS = 0.3;
+/// 1-sigma (s) of the time offset's prior around its coarse value (1 ms grid).
+constexpr double kTimeshiftPriorSigmaS = 0.01;
+
+}  // namespace
+
+void CalibrationPipeline::Impl::addMotion(double from_s, JointProblem* problem) const {
+  for (const MotionFrame& frame : motion_frames) {
+    if (frame.stamp_s >= from_s) problem->motion_frames.push_back(frame);
+  }
+  if (problem->motion_frames.empty()) return;
+  const double gyro_from =
+      std::min(from_s, problem->motion_frames.front().stamp_s) - settings.max_timeshift_s - 0.5;
+  GyroStream& gyro = problem->motion_gyro;
+  for (const auto& [stamp, rate] : motion_gyro) {
+    if (stamp < gyro_from) continue;
+    gyro.stamps_s.push_back(stamp);
+    gyro.gyro_rad_s.push_back(rate);
+  }
+  gyro.noise_density_rad_s_sqrt_hz = last_gyro_noise_density;
+}
+
+std::string prepareMotion(const PipelineSettings& settings, WindowSnapshot* window) {
+  JointProblem& joint = window->joint;
+  const TimeshiftSearch coarse =
+      coarseTimeshift(joint.motion_frames, joint.motion_gyro, settings.max_timeshift_s);
+  if (!coarse.ok) {
+    joint.motion_frames.clear();
+    joint.motion_gyro = GyroStream{};
+    return coarse.message + " (" + "motion frames not used)";
+  }
+  joint.timeshift_initial_s = coarse.timeshift_cam_imu_s;
+  joint.timeshift_prior_sigma_s = kTimeshiftPriorSigmaS;
+  if (!(joint.motion_gyro.noise_density_rad_s_sqrt_hz > 0.0)) {
+    joint.motion_gyro.noise_density_rad_s_sqrt_hz = gyroNoiseDensityOf(joint.motion_gyro);
+  }
+  char buffer[160];
+  std::snprintf(buffer, sizeof(buffer),
+                "%zu frames; timeshift_cam_imu %.1f ms from the angular speeds (+-%.3f s searched)",
+                joint.motion_frames.size(), 1e3 * coarse.timeshift_cam_imu_s,
+                settings.max_timeshift_s);
+  if (!window->pairs.empty()) return buffer;
+  // No rest pairs: pairs of motion frames (camera relative rotation, gyro over the shifted
+  // interval with the ideal gyro and no bias) for the pair solvers.
+  const std::vector<MotionFrame>& frames = joint.motion_frames;
+  const GyroStream& gyro = joint.motion_gyro;
+  size_t from = 0;
+  for (size_t k = 1; k < frames.size(); ++k) {
+    const double dt = frames[k].stamp_s - frames[from].stamp_s;
+    if (dt < kPairSpacingS) continue;
+    if (dt <= 2.0 * kPairSpacingS) {
+      const double t_from = frames[from].stamp_s + coarse.timeshift_cam_imu_s;
+      const double t_to = frames[k].stamp_s + coarse.timeshift_cam_imu_s;
+      if (!gyro.stamps_s.empty() && gyro.stamps_s.front() <= t_from &&
+          gyro.stamps_s.back() >= t_to) {
+        RotationPair pair;
+        pair.A_cam = frames[from].R_target_cam.transpose() * frames[k].R_target_cam;
+        pair.B_imu = preintegrateGyroInterval(gyro.stamps_s, gyro.gyro_rad_s, t_from, t_to,
+                                              Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(),
+                                              Eigen::Vector3d::Zero())
+                         .delta_R;
+        window->pairs.push_back(pair);
+      }
+    }
+    from = k;
+  }
+  return buffer;
+}
+
+}  // namespace camera_imu_alignment

@@ -1,0 +1,96 @@
+// Recordings without rests through the one data path (OnlineCalibrator -> CalibrationPipeline ->
+// joint estimate): camera orientations during continuous motion and the raw gyro, with a camera
+// time offset, against the simulated truth of motion_problem_simulation.h.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "camera_imu_alignment/online/online_calibrator.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
+#include "motion_problem_simulation.h"
+#include "pipeline_simulation.h"
+
+namespace camera_imu_alignment {
+namespace {
+
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+/// Feeds the simulation's gyro (the accelerometer: gravity along the IMU's z, unused while
+/// moving) and its camera orientations (as camera_pose messages) in stamp order.
+void feed(const test::MotionSimulation& sim, OnlineCalibrator* calibrator) {
+  const GyroStream& gyro = sim.problem.motion_gyro;
+  const auto& frames = sim.problem.motion_frames;
+  size_t f = 0;
+  for (size_t i = 0; i < gyro.stamps_s.size(); ++i) {
+    while (f < frames.size() && frames[f].stamp_s <= gyro.stamps_s[i]) {
+      CameraFrame frame;
+      frame.stamp_s = frames[f].stamp_s;
+      frame.R_target_cam = frames[f].R_target_cam;
+      calibrator->addFrame(frame);
+      ++f;
+    }
+    ImuSample sample;
+    sample.stamp_s = gyro.stamps_s[i];
+    sample.gyro_rad_s = gyro.gyro_rad_s[i];
+    sample.accel_m_s2 = Eigen::Vector3d(0.0, 0.0, 9.81);
+    calibrator->addImu(sample);
+  }
+  calibrator->finish();
+}
+
+TEST(MotionCalibrator, CalibratesARecordingWithoutRestsAndFindsTheTimeOffset) {
+  test::MotionSimulationOptions options;  // consumer gyro, 15 ms offset, 60 s
+  options.gyro_scale = 0.0;               // an ideal gyro: see test_joint_motion for the gauge
+  options.gyro_cross_axis = 0.0;
+  for (uint64_t seed : {21, 22}) {
+    const test::MotionSimulation sim = test::simulateMotionProblem(options, seed);
+    std::vector<EstimateEvent> estimates;
+    OnlineCallbacks callbacks;
+    callbacks.on_estimate = [&](const EstimateEvent& e) { estimates.push_back(e); };
+    OnlineSettings online;
+    online.threaded = false;
+    OnlineCalibrator calibrator(test::simulatedTarget(simulation::SimulationConfig{}),
+                                PipelineSettings{}, online, callbacks);
+    feed(sim, &calibrator);
+    const CalibrateOutcome outcome = calibrator.calibrateNow(false);
+    ASSERT_TRUE(outcome.result.joint.has_value()) << outcome.result.message;
+    const JointResult& joint = *outcome.result.joint;
+    ASSERT_TRUE(joint.ok) << joint.message;
+    const double error_deg = geodesicDistance(outcome.result.R_cam_imu, sim.R_cam_imu) / kDeg;
+    std::printf(
+        "seed %llu: error %.4f deg, 1-sigma %.4f deg, timeshift %.3f ms (+- %.3f), %d "
+        "nodes, %zu solves on the way; %s\n",
+        static_cast<unsigned long long>(seed), error_deg, joint.std_dev_deg.norm(),
+        1e3 * joint.timeshift_cam_imu_s, 1e3 * joint.timeshift_sigma_s, joint.motion_nodes,
+        estimates.size(), outcome.result.message.c_str());
+    EXPECT_LT(error_deg, 0.05);
+    EXPECT_LT(error_deg, 3.0 * joint.std_dev_deg.norm());
+    EXPECT_NEAR(joint.timeshift_cam_imu_s, 0.015, 5e-4);
+    // Broadcast (the final solve may be kept back as within min_change_deg of it) and passed.
+    const CalibrationSnapshot snapshot = calibrator.snapshot(SnapshotContents::kState);
+    EXPECT_TRUE(snapshot.broadcast.has_value());
+    ASSERT_TRUE(outcome.verdict.has_value());
+    EXPECT_TRUE(outcome.verdict->passed) << outcome.verdict->text;
+    // The online calibrator solved while the motion came in (every 100 motion frames).
+    EXPECT_GE(estimates.size(), 5u);
+  }
+}
+
+TEST(MotionCalibrator, AnOffsetBeyondTheSearchRangeIsNamedWithTheRange) {
+  test::MotionSimulationOptions options;
+  options.timeshift_cam_imu_s = 0.3;
+  const test::MotionSimulation sim = test::simulateMotionProblem(options, 23);
+  OnlineSettings online;
+  online.threaded = false;
+  OnlineCalibrator calibrator(test::simulatedTarget(simulation::SimulationConfig{}),
+                              PipelineSettings{}, online, {});
+  feed(sim, &calibrator);
+  const CalibrateOutcome outcome = calibrator.calibrateNow(false);
+  EXPECT_FALSE(outcome.broadcast);
+  EXPECT_NE(outcome.result.message.find("beyond the search range of +-0.100 s"), std::string::npos)
+      << outcome.result.message;
+}
+
+}  // namespace
+}  // namespace camera_imu_alignment
