@@ -146,10 +146,10 @@ const std::vector<Key>& simulateBagOptionTable() {
       number<double>("--move-max-s", CIA_MEMBER(config.move_max_s), within(0.2, 600), "s",
                      "longest motion between poses (at least --move-min-s)"),
       wordKey<Options>(
-          "--motion", CIA_MEMBER(config.motion), {"full", "single_axis", "small_angle", "waving"},
+          "--motion", CIA_MEMBER(config.motion), {"full", "single_axis", "small_angle"},
           [](const std::string& word, sim::MotionKind* kind) {
             for (sim::MotionKind k : {sim::MotionKind::kFull, sim::MotionKind::kSingleAxis,
-                                      sim::MotionKind::kSmallAngle, sim::MotionKind::kWaving}) {
+                                      sim::MotionKind::kSmallAngle}) {
               if (word == sim::toString(k)) {
                 *kind = k;
                 return true;
@@ -158,9 +158,9 @@ const std::vector<Key>& simulateBagOptionTable() {
             return false;
           },
           [](sim::MotionKind k) { return sim::toString(k); },
-          "how the rig moves between poses (waving: continuously, no poses)"),
+          "how the rig moves between poses (--scenario waving: continuously, no poses)"),
       number<double>("--duration-s", CIA_MEMBER(config.waving_duration_s), within(1, 3600), "s",
-                     "length of a --motion waving run"),
+                     "length of a --scenario waving run"),
       number<double>("--max-tilt-deg", CIA_MEMBER(config.max_tilt_deg), within(0, 60), "deg",
                      "viewing direction off the target normal"),
       number<double>("--max-roll-deg", CIA_MEMBER(config.max_roll_deg), within(0, 180), "deg",
