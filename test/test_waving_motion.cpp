@@ -2,7 +2,8 @@
 // (waving_motion.h, issue 25): angular speed mostly 20-90 deg/s, never still for more than 0.3 s,
 // all three axes excited, the board in view in every frame, body rate and acceleration equal to
 // the numerical derivatives of orientation and position; and the ROS-free camera orientations of
-// SimulationRun (stamps, time offset sign, noise) against the trajectory and the gyro.
+// SimulationRun (stamps, time offset sign, noise) against the trajectory and the gyro; rendered
+// frames in motion show the whole board.
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -15,6 +16,9 @@
 #include "camera_imu_alignment/simulation/simulation_run.h"
 #include "camera_imu_alignment/simulation/target.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
+#include "camera_imu_alignment/vision/camera_pose.h"
+#include "camera_imu_alignment/vision/target_description.h"
+#include "camera_imu_alignment/vision/target_detector.h"
 #include "test_helpers.h"
 
 namespace camera_imu_alignment {
@@ -95,6 +99,43 @@ TEST(WavingMotion, BoardInViewInEveryFrame) {
     EXPECT_GT(max_view_deg, 20.0) << "seed " << seed;  // the view does sweep
     std::printf("seed %d: board corners at least %.0f px inside the image, view up to %.1f deg\n",
                 static_cast<int>(seed), worst_margin_px, max_view_deg);
+  }
+}
+
+TEST(WavingMotion, RenderedFramesShowTheWholeBoard) {
+  // Frames in motion, rendered with a 5 ms exposure (motion blur) and pixel noise: every corner
+  // detected and PnP close to the true orientation.
+  SimulationConfig c = wavingConfig(2);
+  c.motion_blur_exposure_s = 0.005;
+  const SimulationRun run(c);
+  const ImageRenderer renderer(CameraModel::fromConfig(c),
+                               makeTargetTexture(c.target, textureTexelFor(c)), c.supersample,
+                               c.blur_sigma_px);
+  const TargetDescription target = parseTargetYaml(targetYaml(c.target), "waving target");
+  const TargetDetector detector(target);
+  CameraIntrinsics intrinsics;
+  intrinsics.width = c.width;
+  intrinsics.height = c.height;
+  intrinsics.K << c.fx, 0.0, c.cx, 0.0, c.fy, c.cy, 0.0, 0.0, 1.0;
+  intrinsics.distortion = CameraIntrinsics::Distortion::kPlumbBob;
+  intrinsics.D.assign(c.distortion.begin(), c.distortion.end());
+  for (long j = 37; j < static_cast<long>(run.frame_times.size()); j += 113) {
+    const CameraOrientation& o = run.camera_orientations[j];
+    const cv::Mat mono = ImageRenderer::toMono8(
+        renderer.renderAt(run.trajectory, o.capture_s, c.motion_blur_exposure_s),
+        c.pixel_noise_sigma, run.frameNoiseSeed(j));
+    TargetObservation observation;
+    ASSERT_TRUE(detector.detect(mono, &observation, &o.R_target_cam_true)) << "frame " << j;
+    EXPECT_EQ(static_cast<int>(observation.image_points.size()), target.numPoints());
+    std::string why;
+    const auto pose = estimateCameraPose(observation, target, intrinsics, PoseSettings(), &why);
+    ASSERT_TRUE(pose) << "frame " << j << ": " << why;
+    std::printf("frame %ld: PnP %.3f deg from the truth at %.0f deg/s\n", j,
+                test::angleBetweenDeg(pose->R_target_cam, o.R_target_cam_true),
+                rad2deg(run.trajectory.at(o.capture_s).omega_cam.norm()));
+    EXPECT_LT(test::angleBetweenDeg(pose->R_target_cam, o.R_target_cam_true), 0.1)
+        << "frame " << j << ", speed " << rad2deg(run.trajectory.at(o.capture_s).omega_cam.norm())
+        << " deg/s";
   }
 }
 

@@ -183,7 +183,7 @@ std::string truthYaml(const SimulationRun& run) {
     o << "  - [" << R(i, 0) << ", " << R(i, 1) << ", " << R(i, 2) << ", 0.0]\n";
   }
   o << "  - [0.0, 0.0, 0.0, 1.0]\n";
-  o << "timeshift_cam_imu_s: " << -c.camera_time_offset_s
+  o << "timeshift_cam_imu_s: " << 0.0 - c.camera_time_offset_s  // never "-0"
     << "  # Kalibr's name and sign: t_imu = t_cam + timeshift_cam_imu_s (camera stamps are "
        "true capture time - timeshift)\n";
   o << "remount:\n  enabled: " << (tr.remount() ? "true" : "false") << "\n";
