@@ -1,5 +1,6 @@
 // camera_pose bags end to end: simulate_bag --camera-pose --no-images writes the camera's
-// orientation as geometry_msgs/PoseStamped, calibrate_bag reads it through MessageInput (no
+// orientation as geometry_msgs/PoseStamped (checked against SimulationRun: stamps with the offset,
+// frame, noise), calibrate_bag reads it through MessageInput (no
 // --target, no camera info) and calibrates from the rests as well as from images; a waving bag
 // (no rests) is read and refused as not enough information; the camera source is chosen and said;
 // bad stamps are refused, counted and named.
@@ -9,10 +10,12 @@
 #include <rosbag/view.h>
 #include <yaml-cpp/yaml.h>
 
+#include <Eigen/Geometry>
 #include <filesystem>
 #include <string>
 
 #include "camera_imu_alignment/io/result_yaml.h"
+#include "camera_imu_alignment/simulation/simulation_run.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "tool_runner.h"
 
@@ -71,12 +74,42 @@ TEST(CameraPoseBag, RestsCalibrateFromCameraPosesAsFromImages) {
 TEST(CameraPoseBag, WavingBagIsReadAndRefusedAsNotEnoughInformation) {
   const std::string bag =
       simulate("waving",
-               "--scenario waving --duration-s 10 --imu-grade consumer --camera-pose --no-images "
+               "--scenario waving --seed 1 --duration-s 10 --imu-grade consumer --camera-pose "
+               "--no-images "
                "--camera-time-offset-s 0.015");
   const YAML::Node truth = YAML::LoadFile(test::bagStem(bag) + ".truth.yaml");
   EXPECT_DOUBLE_EQ(truth["timeshift_cam_imu_s"].as<double>(), -0.015);
   EXPECT_EQ(truth["stationary_intervals"].size(), 0u);
   EXPECT_EQ(truth["counts"]["camera_poses"].as<int>(), 51);  // 10 s at 5 Hz
+  // The messages: the simulator's camera orientations (same seed, same noise), stamped at true
+  // capture time + offset, in the target frame, at the camera rate.
+  simulation::SimulationConfig config;
+  config.seed = 1;
+  ASSERT_TRUE(simulation::applyScenario("waving", &config));
+  simulation::applyImuGrade(simulation::ImuGrade::kConsumer, &config);
+  config.waving_duration_s = 10.0;
+  config.camera_rate_hz = 5.0;
+  config.camera_time_offset_s = 0.015;
+  const simulation::SimulationRun sim(config);
+  {
+    rosbag::Bag in(bag, rosbag::bagmode::Read);
+    std::size_t k = 0;
+    for (const rosbag::MessageInstance& m : rosbag::View(in, rosbag::TopicQuery("/camera_pose"))) {
+      const auto pose = m.instantiate<geometry_msgs::PoseStamped>();
+      ASSERT_TRUE(pose);
+      ASSERT_LT(k, sim.camera_orientations.size());
+      const simulation::CameraOrientation& o = sim.camera_orientations[k++];
+      EXPECT_NEAR(pose->header.stamp.toSec(), config.start_time_s + o.capture_s + 0.015, 1e-6);
+      EXPECT_EQ(pose->header.frame_id, "calibration_target");
+      const auto& q = pose->pose.orientation;
+      const Eigen::Matrix3d R = Eigen::Quaterniond(q.w, q.x, q.y, q.z).toRotationMatrix();
+      EXPECT_LT(test::angleBetweenDeg(R, o.R_target_cam), 1e-6);
+      const double noise_deg = test::angleBetweenDeg(R, o.R_target_cam_true);
+      EXPECT_GT(noise_deg, 0.0);
+      EXPECT_LT(noise_deg, 0.02 * 6.0);  // 0.02 deg per axis, far below 6 sigma
+    }
+    EXPECT_EQ(k, 51u);
+  }
   const test::ToolRun run = test::runTool(kCalibrate + " --quiet --bag " + bag);
   EXPECT_EQ(run.exit_code, 3) << run.err << run.out;  // not enough information, not a crash
   EXPECT_NE(run.err.find("51 camera poses; 0 stationary rests, 0 poses"), std::string::npos)
