@@ -1,9 +1,9 @@
 // camera_pose bags end to end: simulate_bag --camera-pose --no-images writes the camera's
 // orientation as geometry_msgs/PoseStamped (checked against SimulationRun: stamps with the offset,
-// frame, noise), calibrate_bag reads it through MessageInput (no
-// --target, no camera info) and calibrates from the rests as well as from images; a waving bag
-// (no rests) is read and refused as not enough information; the camera source is chosen and said;
-// bad stamps are refused, counted and named.
+// frame, noise); calibrate_bag reads it through MessageInput (no --target, no camera info) and
+// calibrates from the rests as well as from images; a waving bag (no rests) is read and refused as
+// not enough information; the camera source is chosen and said; bad stamps are refused, counted
+// and named.
 #include <geometry_msgs/PoseStamped.h>
 #include <gtest/gtest.h>
 #include <rosbag/bag.h>
