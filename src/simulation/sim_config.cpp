@@ -14,6 +14,10 @@ const std::vector<std::pair<std::string, std::string>>& scenarioList() {
       {"wall_board",
        "hand-held in front of a board on a wall: 12 rests of 3-5 s, view within 35 deg of the "
        "board's normal, roll within 45 deg (gravity spans a narrow cone; any --imu-grade)"},
+      {"waving",
+       "hand-held, waved in front of the board for 60 s without rests (Kalibr-style): all axes, "
+       "20-90 deg/s, view within 35 deg of the board's normal, roll within 45 deg (any "
+       "--imu-grade)"},
       {"aprilgrid", "nominal with a Kalibr AprilGrid (tag36h11) target"},
       {"circlegrid", "nominal with a symmetric circle grid target"},
       {"noisy_imu", "nominal with every sensor noise x5"},
@@ -52,6 +56,12 @@ bool applyScenario(const std::string& name, SimulationConfig* config) {
     c.hold_max_s = 5.0;
     c.max_tilt_deg = 35.0;
     c.max_roll_deg = 45.0;
+  } else if (name == "waving") {
+    c.motion = MotionKind::kWaving;
+    c.waving_duration_s = 60.0;
+    c.max_tilt_deg = 35.0;
+    c.max_roll_deg = 45.0;
+    c.min_distance_m = 0.6;
   } else if (name == "aprilgrid") {
     c.target.type = TargetType::kAprilgrid;
     c.target.cols = 4;
@@ -107,6 +117,8 @@ std::string validateConfig(const SimulationConfig& c) {
     e << "hold time range must satisfy 0.1 <= hold_min_s <= hold_max_s <= 600; ";
   if (!inRange(c.move_min_s, 0.2, 600) || !inRange(c.move_max_s, c.move_min_s, 600))
     e << "motion time range must satisfy 0.2 <= move_min_s <= move_max_s <= 600; ";
+  if (!inRange(c.waving_duration_s, 1, 3600)) e << "waving_duration_s must be in [1, 3600]; ";
+  if (!inRange(c.camera_pose_noise_deg, 0, 10)) e << "camera_pose_noise_deg must be in [0, 10]; ";
   if (!inRange(c.max_tilt_deg, 0, 60)) e << "max_tilt_deg must be in [0, 60]; ";
   if (!inRange(c.max_roll_deg, 0, 180)) e << "max_roll_deg must be in [0, 180]; ";
   if (!inRange(c.min_distance_m, 0.1, 10) || !inRange(c.max_distance_m, c.min_distance_m, 10))
@@ -181,6 +193,8 @@ const char* toString(MotionKind kind) {
       return "single_axis";
     case MotionKind::kSmallAngle:
       return "small_angle";
+    case MotionKind::kWaving:
+      return "waving";
     default:
       return "full";
   }

@@ -122,6 +122,29 @@ void imuErrorsYaml(const ImuErrors& e, const ImuSystematicSigmas& sigmas, Writer
 
 }  // namespace
 
+std::vector<CameraOrientation> simulateCameraOrientations(const SimulationConfig& config,
+                                                          const Trajectory& trajectory,
+                                                          const std::vector<double>& frame_times) {
+  std::mt19937_64 rng(streamSeed(config.seed, 7));
+  std::normal_distribution<double> unit(0.0, 1.0);
+  const double sigma = deg2rad(config.noise_scale * config.camera_pose_noise_deg);
+  std::vector<CameraOrientation> out;
+  out.reserve(frame_times.size());
+  const Eigen::Matrix3d R_target_world = trajectory.R_world_target().transpose();
+  for (double t : frame_times) {
+    const RigState st = trajectory.at(t);
+    CameraOrientation o;
+    o.capture_s = t;
+    o.stamp_s = t + config.camera_time_offset_s;
+    o.R_target_cam_true = R_target_world * st.R_world_cam;
+    o.p_target_cam = R_target_world * (st.p_world_cam - trajectory.p_world_target());
+    const Eigen::Vector3d n(unit(rng), unit(rng), unit(rng));
+    o.R_target_cam = o.R_target_cam_true * expSO3(sigma * n);
+    out.push_back(o);
+  }
+  return out;
+}
+
 SimulationRun::SimulationRun(const SimulationConfig& c)
     : config(c),
       trajectory(c),
@@ -131,6 +154,7 @@ SimulationRun::SimulationRun(const SimulationConfig& c)
       imu_errors(drawImuErrors(c)) {
   const long frames = static_cast<long>(std::floor(trajectory.duration() * c.camera_rate_hz)) + 1;
   for (long j = 0; j < frames; ++j) frame_times.push_back(j / c.camera_rate_hz);
+  camera_orientations = simulateCameraOrientations(c, trajectory, frame_times);
   if (c.bad_input) {
     bad_input =
         planBadInput(c.seed, static_cast<long>(imu.size()), static_cast<long>(mag.size()), frames);
@@ -159,6 +183,9 @@ std::string truthYaml(const SimulationRun& run) {
     o << "  - [" << R(i, 0) << ", " << R(i, 1) << ", " << R(i, 2) << ", 0.0]\n";
   }
   o << "  - [0.0, 0.0, 0.0, 1.0]\n";
+  o << "timeshift_cam_imu_s: " << 0.0 - c.camera_time_offset_s  // never "-0"
+    << "  # Kalibr's name and sign: t_imu = t_cam + timeshift_cam_imu_s (camera stamps are "
+       "true capture time - timeshift)\n";
   o << "remount:\n  enabled: " << (tr.remount() ? "true" : "false") << "\n";
   if (tr.remount()) {
     o << std::setprecision(16) << "  time_s: " << t0 + tr.remountTime() << std::setprecision(12)
@@ -173,10 +200,12 @@ std::string truthYaml(const SimulationRun& run) {
   o << "gravity_world: ";
   w.vec(c.gravity_world);
   o << "  # m/s^2, ENU\nmotion: " << toString(c.motion) << "\n";
-  o << "stationary_intervals:  # [start_s, end_s], bag time\n" << std::setprecision(16);
+  const char* none = tr.poses().empty() ? " []" : "";  // waving: no rests
+  o << "stationary_intervals:" << none << "  # [start_s, end_s], bag time\n"
+    << std::setprecision(16);
   for (const StationaryPose& p : tr.poses())
     o << "  - [" << t0 + p.start_s << ", " << t0 + p.end_s << "]\n";
-  o << std::setprecision(12) << "poses:  # true orientations during each hold\n";
+  o << std::setprecision(12) << "poses:" << none << "  # true orientations during each hold\n";
   for (size_t k = 0; k < tr.poses().size(); ++k) {
     const StationaryPose& p = tr.poses()[k];
     const RigState st = tr.at(0.5 * (p.start_s + p.end_s));
@@ -208,6 +237,10 @@ std::string truthYaml(const SimulationRun& run) {
     << "  blur_sigma_px: " << c.blur_sigma_px
     << "\n  pixel_noise_sigma: " << c.noise_scale * c.pixel_noise_sigma
     << "\n  motion_blur_exposure_s: " << c.motion_blur_exposure_s << "\n";
+  if (c.camera_pose) {
+    o << "  pose_noise_deg: " << c.noise_scale * c.camera_pose_noise_deg
+      << "  # 1-sigma per axis of the camera_pose orientations\n";
+  }
   const SensorNoise& n = c.imu_noise;
   const double k = c.noise_scale;
   o << "imu:  # Kalibr imu.yaml terms, noise_scale applied\n  rate_hz: " << c.imu_rate_hz
@@ -246,8 +279,13 @@ std::string truthYaml(const SimulationRun& run) {
   imuErrorsYaml(run.imu_errors, c.imu_systematic, &w);
   o << "topics:\n  imu: " << c.imu_topic << "\n  magnetometer: " << c.mag_topic
     << "\n  image: " << c.image_topic << "\n  camera_info: " << c.camera_info_topic << "\n";
+  if (c.camera_pose) {
+    o << "  camera_pose: " << c.camera_pose_topic << "  # geometry_msgs/PoseStamped, frame_id "
+      << c.target_frame << "\n";
+  }
   o << "counts:\n  imu: " << run.imu.size() << "\n  magnetometer: " << run.mag.size()
-    << "\n  images: " << run.frame_times.size() << "\n";
+    << "\n  images: " << (c.images ? run.frame_times.size() : 0) << "\n";
+  if (c.camera_pose) o << "  camera_poses: " << run.camera_orientations.size() << "\n";
   const BadInputPlan& b = run.bad_input;
   o << "bad_input:\n  enabled: " << (c.bad_input ? "true" : "false") << "\n";
   std::vector<double> imu_t, mag_t;

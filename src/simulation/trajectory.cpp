@@ -56,6 +56,15 @@ Trajectory::Trajectory(const SimulationConfig& config) {
   p_world_target_ = Eigen::Vector3d(-0.2, 2.0, 1.0);
 
   const Eigen::Vector3d centre = targetCentre(config.target);
+  remount_ = config.remount;
+  remount_rotvec_ = config.remount_rotvec_cam;
+  if (config.motion == MotionKind::kWaving) {
+    waving_ = true;
+    waving_motion_ = WavingMotion(config, centre, &rng);
+    duration_ = config.waving_duration_s;
+    remount_time_ = config.remount_time_s >= 0.0 ? config.remount_time_s : 0.5 * duration_;
+    return;
+  }
   double max_tilt = deg2rad(config.max_tilt_deg), max_roll = deg2rad(config.max_roll_deg);
   if (config.motion == MotionKind::kSmallAngle) {
     max_tilt = std::min(max_tilt, deg2rad(4.0));
@@ -92,8 +101,6 @@ Trajectory::Trajectory(const SimulationConfig& config) {
   }
   duration_ = poses_.back().end_s;
 
-  remount_ = config.remount;
-  remount_rotvec_ = config.remount_rotvec_cam;
   if (remount_) {
     const int k = std::max(0, n / 2 - 1);
     remount_time_ = config.remount_time_s >= 0.0
@@ -107,7 +114,7 @@ Eigen::Matrix3d Trajectory::R_cam_imu_final() const {
                   : R_cam_imu_initial_;
 }
 
-RigState Trajectory::at(double t) const {
+RigState Trajectory::poseMotionAt(double t) const {
   RigState st;
   // Last pose starting at or before t.
   auto it = std::upper_bound(poses_.begin(), poses_.end(), t,
@@ -128,6 +135,20 @@ RigState Trajectory::at(double t) const {
     st.omega_cam = (df / T) * phi;
     st.p_world_cam = a.p_world_cam + f * (b.p_world_cam - a.p_world_cam);
     st.a_world = (ddf / (T * T)) * (b.p_world_cam - a.p_world_cam);
+  }
+  return st;
+}
+
+RigState Trajectory::at(double t) const {
+  RigState st;
+  if (waving_) {
+    const WavingState w = waving_motion_.at(t);
+    st.R_world_cam = R_world_target_ * w.R_target_cam;
+    st.p_world_cam = p_world_target_ + R_world_target_ * w.p_target_cam;
+    st.omega_cam = w.omega_cam;
+    st.a_world = R_world_target_ * w.a_target;
+  } else {
+    st = poseMotionAt(t);
   }
   st.R_cam_imu = R_cam_imu_initial_;
   Eigen::Vector3d omega_mount = Eigen::Vector3d::Zero();  // IMU rate relative to the camera

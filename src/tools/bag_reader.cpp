@@ -1,6 +1,7 @@
 // calibrate_bag's bag reading (bag_reader.h).
 #include "bag_reader.h"
 
+#include <geometry_msgs/PoseStamped.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/CompressedImage.h>
@@ -76,6 +77,7 @@ std::string BagRejectLog::topicOf(InputStream stream) const {
     case InputStream::kCameraInfo:
       return topics_.camera_info;
     case InputStream::kCameraPose:
+      if (!topics_.camera_pose.empty()) return topics_.camera_pose;
       break;
   }
   return toString(stream);
@@ -127,7 +129,7 @@ bool readBagWindow(const CliArgs& args, BagRunInfo* info) {
 void readBag(const rosbag::Bag& bag, const BagTopics& topics, OnlineCalibrator* calibrator,
              BagProgress* progress, BagRunInfo* info) {
   std::vector<std::string> names = {topics.imu};
-  for (const auto& t : {topics.mag, topics.image, topics.camera_info}) {
+  for (const auto& t : {topics.mag, topics.image, topics.camera_info, topics.camera_pose}) {
     if (!t.empty()) names.push_back(t);
   }
   rosbag::View view;
@@ -152,6 +154,9 @@ void readBag(const rosbag::Bag& bag, const BagTopics& topics, OnlineCalibrator* 
     } else if (topic == topics.camera_info) {
       ++info->info_messages;
       if (const auto msg = m.instantiate<sensor_msgs::CameraInfo>()) input.setCameraInfo(*msg);
+    } else if (topic == topics.camera_pose) {
+      ++info->camera_pose_messages;
+      if (const auto msg = m.instantiate<geometry_msgs::PoseStamped>()) input.addCameraPose(*msg);
     } else if (topic == topics.image) {
       ++info->image_messages;
       if (topics.image_compressed) {

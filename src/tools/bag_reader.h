@@ -48,7 +48,7 @@ class BagRejectLog {
 /// What the reading saw besides the samples.
 struct BagRunInfo {
   std::string camera_frame, imu_frame;  ///< from the messages' headers ("" when none)
-  std::uint64_t image_messages = 0, info_messages = 0;
+  std::uint64_t image_messages = 0, info_messages = 0, camera_pose_messages = 0;
   double start_s = 0.0, end_s = 0.0;  ///< the bag's time span (set by the caller)
   /// --start / --end: only the messages in [start_s, end_s] (bag time, s) are read, start_s and
   /// end_s narrowed to them.

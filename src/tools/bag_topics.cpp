@@ -14,6 +14,7 @@ const char* kMag = "sensor_msgs/MagneticField";
 const char* kImage = "sensor_msgs/Image";
 const char* kCompressed = "sensor_msgs/CompressedImage";
 const char* kInfo = "sensor_msgs/CameraInfo";
+const char* kPose = "geometry_msgs/PoseStamped";
 
 std::string normalise(std::string topic) {
   if (!topic.empty() && topic[0] != '/') topic = "/" + topic;
@@ -66,16 +67,27 @@ std::string pick(const std::map<std::string, std::string>& types, const std::str
   return candidates.front();
 }
 
-}  // namespace
+/// The camera_pose topic to use without --camera-pose-topic: a PoseStamped topic whose last name
+/// is camera_pose ("/camera_pose", "/cam0/camera_pose"); "" when none, an error when several.
+std::string defaultCameraPoseTopic(const std::map<std::string, std::string>& types) {
+  std::vector<std::string> found;
+  for (const auto& [topic, type] : types) {
+    const std::string t = normalise(topic);
+    if (type == kPose && t.size() >= 12 && t.compare(t.size() - 12, 12, "/camera_pose") == 0) {
+      found.push_back(topic);
+    }
+  }
+  if (found.size() > 1) {
+    throw std::runtime_error("several camera pose topics in the bag (" + list(found) +
+                             "): choose one with --camera-pose-topic");
+  }
+  return found.empty() ? "" : found.front();
+}
 
-BagTopics selectBagTopics(const rosbag::Bag& bag, const BagTopics& requested) {
-  std::map<std::string, std::string> types;
-  rosbag::View view(bag);
-  for (const rosbag::ConnectionInfo* c : view.getConnections()) types[c->topic] = c->datatype;
-
-  BagTopics topics;
-  topics.imu = pick(types, requested.imu, {kImu}, "IMU", true, "--imu-topic");
-  topics.mag = pick(types, requested.mag, {kMag}, "magnetometer", false, "--mag-topic");
+/// Images and their camera info (requested or detected by type), into `topics`.
+void selectImageTopics(std::map<std::string, std::string> types, const BagTopics& requested,
+                       BagTopics* out) {
+  BagTopics& topics = *out;
   // Images: a raw and a compressed topic of the same camera are common; prefer the raw one.
   if (requested.image.empty()) {
     topics.image = pick(types, "", {kImage}, "image", false, "--image-topic");
@@ -97,11 +109,47 @@ BagTopics selectBagTopics(const rosbag::Bag& bag, const BagTopics& requested) {
     const std::string sibling = base.substr(0, base.find_last_of('/')) + "/camera_info";
     if (types.count(sibling) && types[sibling] == kInfo) {
       topics.camera_info = sibling;
-      return topics;
+      return;
     }
   }
   topics.camera_info =
       pick(types, requested.camera_info, {kInfo}, "camera info", false, "--camera-info-topic");
+}
+
+}  // namespace
+
+BagTopics selectBagTopics(const rosbag::Bag& bag, const BagTopics& requested) {
+  std::map<std::string, std::string> types;
+  rosbag::View view(bag);
+  for (const rosbag::ConnectionInfo* c : view.getConnections()) types[c->topic] = c->datatype;
+
+  BagTopics topics;
+  topics.imu = pick(types, requested.imu, {kImu}, "IMU", true, "--imu-topic");
+  topics.mag = pick(types, requested.mag, {kMag}, "magnetometer", false, "--mag-topic");
+  if (!requested.camera_pose.empty()) {  // camera poses chosen explicitly
+    if (!requested.image.empty() || !requested.camera_info.empty()) {
+      throw std::runtime_error(
+          "--camera-pose-topic with --image-topic / --camera-info-topic: give one camera source, "
+          "camera poses or images");
+    }
+    topics.camera_pose =
+        pick(types, requested.camera_pose, {kPose}, "camera pose", true, "--camera-pose-topic");
+    topics.camera_source_note = "camera source: camera poses on " + topics.camera_pose +
+                                " (--camera-pose-topic; images, if any, are not read)";
+    return topics;
+  }
+  const std::string pose_topic = defaultCameraPoseTopic(types);
+  selectImageTopics(types, requested, &topics);
+  if (topics.image.empty() && !pose_topic.empty()) {
+    topics.camera_info.clear();
+    topics.camera_pose = pose_topic;
+    topics.camera_source_note =
+        "camera source: camera poses on " + pose_topic + " (the bag has no image topic)";
+  } else if (!topics.image.empty() && !pose_topic.empty()) {
+    topics.camera_source_note =
+        "camera source: images on " + topics.image + "; the bag also has camera poses on " +
+        pose_topic + ", not read (--camera-pose-topic " + pose_topic + " uses them instead)";
+  }
   return topics;
 }
 

@@ -45,17 +45,24 @@ using cia::kExitOk;
 using cia::kExitQualityGate;
 
 const char* kUsage =
-    "usage: calibrate_bag --bag FILE.bag --target TARGET.yaml [--config PARAMS.yaml]\n"
+    "usage: calibrate_bag --bag FILE.bag [--target TARGET.yaml] [--config PARAMS.yaml]\n"
     "                     [--imu-topic T] [--mag-topic T] [--image-topic T]\n"
-    "                     [--camera-info-topic T] [--method optimal|two_step]\n"
+    "                     [--camera-info-topic T] [--camera-pose-topic T]\n"
+    "                     [--method optimal|two_step]\n"
     "                     [--imu-orientation joint|auto|magnetometer|message]\n"
     "                     [--output RESULT.yaml] [--imu-yaml IMU.yaml] [--report REPORT.png]\n"
     "                     [--truth TRUTH.yaml] [--export-poses POSES.csv]\n"
     "                     [--check CURRENT.yaml] [--start S] [--end S]\n"
     "                     [--accept-last-mount] [--quiet]\n"
     "  --bag FILE.bag        ROS 1 bag: sensor_msgs/Imu, optional MagneticField, Image or\n"
-    "                        CompressedImage and CameraInfo (topics found by type when not given)\n"
-    "  --target TARGET.yaml  Kalibr target file (checkerboard, aprilgrid, circlegrid)\n"
+    "                        CompressedImage and CameraInfo (topics found by type when not "
+    "given),\n"
+    "                        or geometry_msgs/PoseStamped camera poses instead of the images\n"
+    "  --target TARGET.yaml  Kalibr target file (checkerboard, aprilgrid, circlegrid); required\n"
+    "                        with images, not with camera poses\n"
+    "  --camera-pose-topic T camera poses (geometry_msgs/PoseStamped, the camera in the target\n"
+    "                        frame) as the camera source, images not read. Default: a topic\n"
+    "                        named camera_pose when the bag has no image topic\n"
     "  --config PARAMS.yaml  settings, keys as in config/default.yaml\n"
     "  --method M            optimal (default) or two_step (the paper's iteration alone)\n"
     "  --imu-orientation S   joint (default: one estimate from every sensor with the IMU's errors\n"
@@ -86,6 +93,11 @@ const char* kUsage =
     "exit codes: 0 success, 2 bad input or usage, 3 not enough information (the message says what\n"
     "motion is missing), 4 an estimate that fails the quality gates or a mount that moved during\n"
     "the recording (the verdict line says which; nothing is written)\n";
+
+const char* kNoCameraData =
+    "no camera data (no sensor_msgs/Image or CompressedImage messages, no "
+    "geometry_msgs/PoseStamped "
+    "on camera_pose or --camera-pose-topic); the IMU alone cannot give R_cam_imu";
 
 /// --imu-yaml: the Kalibr imu.yaml of the joint estimate. White noise densities from the rests:
 /// the median over the rests of the per-sample scatter times sqrt(sample period).
@@ -126,7 +138,7 @@ int run(const cia::CliArgs& args) {
   cia::PipelineSettings settings;
   cia::OnlineSettings online;  // the nodelet's quality gates and change detection
   try {
-    target = cia::loadTargetYaml(args.get("--target"));
+    if (args.has("--target")) target = cia::loadTargetYaml(args.get("--target"));
     if (args.has("--config")) {
       cia::loadCalibrationConfig(args.get("--config"), &settings, &online, cia::wrapperKeys());
     }
@@ -170,8 +182,9 @@ int run(const cia::CliArgs& args) {
   cia::BagRunInfo info;
   try {
     bag.open(bag_path, rosbag::bagmode::Read);
-    cia::BagTopics requested{args.get("--imu-topic"), args.get("--mag-topic"),
-                             args.get("--image-topic"), false, args.get("--camera-info-topic")};
+    cia::BagTopics requested{args.get("--imu-topic"),         args.get("--mag-topic"),
+                             args.get("--image-topic"),       false,
+                             args.get("--camera-info-topic"), args.get("--camera-pose-topic")};
     topics = cia::selectBagTopics(bag, requested);
     rosbag::View all(bag);
     info.start_s = all.getBeginTime().toSec();
@@ -181,11 +194,30 @@ int run(const cia::CliArgs& args) {
     std::cerr << "calibrate_bag: " << bag_path << ": " << e.what() << "\n";
     return kExitBadInput;
   }
+  const bool camera_poses = !topics.camera_pose.empty();
+  if (!topics.camera_source_note.empty()) {
+    std::cerr << "[calibrate_bag] " << topics.camera_source_note << "\n";
+  }
+  if (!camera_poses && !args.has("--target")) {
+    if (topics.image.empty()) {
+      std::cerr << "calibrate_bag: " << bag_path << ": " << kNoCameraData << "\n";
+    } else {
+      std::cerr << "calibrate_bag: --target is required: the camera source is images on "
+                << topics.image
+                << ", and detecting the board needs its description (camera poses, "
+                   "geometry_msgs/PoseStamped on camera_pose or --camera-pose-topic, need none)\n";
+    }
+    return kExitBadInput;
+  }
   std::cerr << "[calibrate_bag] " << bag_path << ": IMU " << topics.imu << ", magnetometer "
-            << (topics.mag.empty() ? "(none)" : topics.mag) << ", images "
-            << (topics.image.empty() ? "(none)" : topics.image) << ", camera info "
-            << (topics.camera_info.empty() ? "(none)" : topics.camera_info) << "; target "
-            << target.describe() << "\n";
+            << (topics.mag.empty() ? "(none)" : topics.mag);
+  if (camera_poses) {
+    std::cerr << ", camera poses " << topics.camera_pose << " (no target or camera info needed)\n";
+  } else {
+    std::cerr << ", images " << (topics.image.empty() ? "(none)" : topics.image) << ", camera info "
+              << (topics.camera_info.empty() ? "(none)" : topics.camera_info) << "; target "
+              << target.describe() << "\n";
+  }
 
   // --- Run the pipeline over the bag.
   // The nodelet's calibrator (poses, solves, change detection, gates), solving as poses arrive.
@@ -216,15 +248,22 @@ int run(const cia::CliArgs& args) {
   const cia::CalibrateOutcome outcome = calibrator->calibrateNow(false);
   const cia::CalibrationSnapshot snap = calibrator->snapshot(cia::SnapshotContents::kWithHistory);
   std::cerr << "[calibrate_bag] read " << snap.inputs.imu_samples << " IMU, "
-            << snap.inputs.magnetic_samples << " magnetometer samples, " << info.image_messages
-            << " images; " << snap.rests.size() << " stationary rests, " << snap.poses.size()
-            << " poses\n";
-  if (topics.image.empty() || info.image_messages == 0) {
-    std::cerr << "calibrate_bag: " << bag_path << ": no camera data (no sensor_msgs/Image or "
-              << "CompressedImage messages); the IMU alone cannot give R_cam_imu\n";
+            << snap.inputs.magnetic_samples << " magnetometer samples, "
+            << (camera_poses ? info.camera_pose_messages : info.image_messages)
+            << (camera_poses ? " camera poses; " : " images; ") << snap.rests.size()
+            << " stationary rests, " << snap.poses.size() << " poses\n";
+  if (camera_poses && info.camera_pose_messages == 0) {
+    std::cerr << "calibrate_bag: " << bag_path << ": no messages on " << topics.camera_pose
+              << " (geometry_msgs/PoseStamped)"
+              << (info.windowed ? " between --start and --end" : "")
+              << "; the IMU alone cannot give R_cam_imu\n";
     return kExitBadInput;
   }
-  if (!snap.inputs.has_intrinsics) {
+  if (!camera_poses && (topics.image.empty() || info.image_messages == 0)) {
+    std::cerr << "calibrate_bag: " << bag_path << ": " << kNoCameraData << "\n";
+    return kExitBadInput;
+  }
+  if (!camera_poses && !snap.inputs.has_intrinsics) {
     std::cerr << "calibrate_bag: " << bag_path << ": no usable camera info ("
               << (topics.camera_info.empty() ? "no sensor_msgs/CameraInfo topic"
                                              : topics.camera_info)
@@ -280,6 +319,11 @@ int run(const cia::CliArgs& args) {
   const cia::SolveStatus status = report.result.status;
   if (status != cia::SolveStatus::kOk) {
     std::cerr << "calibrate_bag: " << report.result.message << "\n";
+    if (snap.rests.empty()) {
+      std::cerr << "calibrate_bag: " << bag_path << ": the recording has no stationary rests (the "
+                << "rig never held still), and the estimate needs them: record again holding the "
+                   "rig still for a few seconds at each of several orientations\n";
+    }
     const std::string target_problem = snap.target_diagnosis;
     if (!target_problem.empty()) {  // the target file, not the recording
       std::cerr << "calibrate_bag: " << args.get("--target") << ": " << target_problem << "\n";
@@ -326,12 +370,12 @@ int run(const cia::CliArgs& args) {
 int main(int argc, char** argv) {
   cia::CliArgs args = [&] {
     try {
-      return cia::CliArgs(
-          argc, argv,
-          {"--bag", "--target", "--config", "--imu-topic", "--mag-topic", "--image-topic",
-           "--camera-info-topic", "--method", "--imu-orientation", "--output", "--imu-yaml",
-           "--report", "--truth", "--export-poses", "--check", "--start", "--end"},
-          {"--help", "--quiet", "--accept-last-mount"});
+      return cia::CliArgs(argc, argv,
+                          {"--bag", "--target", "--config", "--imu-topic", "--mag-topic",
+                           "--image-topic", "--camera-info-topic", "--camera-pose-topic",
+                           "--method", "--imu-orientation", "--output", "--imu-yaml", "--report",
+                           "--truth", "--export-poses", "--check", "--start", "--end"},
+                          {"--help", "--quiet", "--accept-last-mount"});
     } catch (const cia::UsageError& e) {
       std::cerr << "calibrate_bag: " << e.what() << "\n" << kUsage;
       std::exit(kExitBadInput);
@@ -341,8 +385,8 @@ int main(int argc, char** argv) {
     std::cout << kUsage;
     return kExitOk;
   }
-  if (!args.has("--bag") || !args.has("--target")) {
-    std::cerr << "calibrate_bag: --bag and --target are required\n" << kUsage;
+  if (!args.has("--bag")) {
+    std::cerr << "calibrate_bag: --bag is required\n" << kUsage;
     return kExitBadInput;
   }
   return run(args);

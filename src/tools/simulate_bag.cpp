@@ -3,6 +3,7 @@
 // (FILE.target.yaml). The science lives in camera_imu_alignment_simulation; this file only parses
 // options, converts to ROS messages and writes the bag. Exit codes: 0 ok, 2 bad usage or input
 // (message names the option).
+#include <geometry_msgs/PoseStamped.h>
 #include <rosbag/bag.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
@@ -17,6 +18,7 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 #include "camera_imu_alignment/simulation/renderer.h"
@@ -34,8 +36,8 @@ namespace {
 std::string usage() {
   std::ostringstream o;
   o << "usage: simulate_bag --out FILE.bag [--seed N] [--scenario NAME] [options]\n"
-       "  Writes FILE.bag (sensor_msgs/Imu, MagneticField, Image mono8, CameraInfo), "
-       "FILE.truth.yaml\n"
+       "  Writes FILE.bag (sensor_msgs/Imu, MagneticField, Image mono8, CameraInfo; with\n"
+       "  --camera-pose geometry_msgs/PoseStamped), FILE.truth.yaml\n"
        "  (R_cam_imu, stationary intervals, true poses, noise) and FILE.target.yaml (Kalibr).\n"
        "Scenarios (presets; options below override them):\n";
   for (const auto& s : sim::scenarioList()) o << "  " << s.first << ": " << s.second << "\n";
@@ -76,6 +78,23 @@ sensor_msgs::CameraInfo cameraInfo(const sim::SimulationConfig& c) {
   info.R = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
   info.P = {c.fx, 0.0, c.cx, 0.0, 0.0, c.fy, c.cy, 0.0, 0.0, 0.0, 1.0, 0.0};
   return info;
+}
+
+/// The camera in the target frame (doc/CONVENTIONS.md): orientation q_target_cam (with the
+/// simulated noise), position p_target_cam; frame_id the target frame; stamped as the images.
+geometry_msgs::PoseStamped cameraPoseMessage(const sim::CameraOrientation& o, double t0,
+                                             const std::string& target_frame, std::uint32_t* seq) {
+  geometry_msgs::PoseStamped m;
+  setHeader(&m.header, seq, t0 + o.stamp_s, target_frame);
+  const Eigen::Quaterniond q(o.R_target_cam);
+  m.pose.orientation.x = q.x();
+  m.pose.orientation.y = q.y();
+  m.pose.orientation.z = q.z();
+  m.pose.orientation.w = q.w();
+  m.pose.position.x = o.p_target_cam.x();
+  m.pose.position.y = o.p_target_cam.y();
+  m.pose.position.z = o.p_target_cam.z();
+  return m;
 }
 
 }  // namespace
@@ -120,9 +139,12 @@ int writeBag(const sim::SimulationRun& run, const std::string& path, const BagOp
   if (mag_frame != c.imu_frame && c.magnetometer) {
     bag.write("/tf_static", ros::Time(c.start_time_s), magnetometerTf(c, options));
   }
-  const sim::ImageRenderer renderer(sim::CameraModel::fromConfig(c),
-                                    sim::makeTargetTexture(c.target, sim::textureTexelFor(c)),
-                                    c.supersample, c.blur_sigma_px);
+  std::optional<sim::ImageRenderer> renderer;  // --no-images: no texture, nothing rendered
+  if (c.images) {
+    renderer.emplace(sim::CameraModel::fromConfig(c),
+                     sim::makeTargetTexture(c.target, sim::textureTexelFor(c)), c.supersample,
+                     c.blur_sigma_px);
+  }
 
   // IMU and magnetometer messages up to a bag time, in sample order (bag time = true sample time;
   // injected out-of-order stamps only change the header stamps).
@@ -130,7 +152,7 @@ int writeBag(const sim::SimulationRun& run, const std::string& path, const BagOp
   const double gyro_var = std::pow(k * c.imu_noise.gyroscope_noise_density, 2) * c.imu_rate_hz;
   const double accel_var = std::pow(k * c.imu_noise.accelerometer_noise_density, 2) * c.imu_rate_hz;
   const double mag_var = std::pow(k * c.imu_noise.magnetometer_noise_sigma, 2);
-  std::uint32_t imu_seq = 0, mag_seq = 0, image_seq = 0, info_seq = 0;
+  std::uint32_t imu_seq = 0, mag_seq = 0, image_seq = 0, info_seq = 0, pose_seq = 0;
   long next_imu = 0, next_mag = 0;
   const auto writeInertialUpTo = [&](double bag_time) {
     for (; next_imu < static_cast<long>(run.imu.size()) && t0 + run.imu[next_imu].t <= bag_time;
@@ -183,18 +205,23 @@ int writeBag(const sim::SimulationRun& run, const std::string& path, const BagOp
   for (long j = 0; j < static_cast<long>(run.frame_times.size()); ++j) {
     const double t = run.frame_times[j], stamp = t0 + t + c.camera_time_offset_s;
     writeInertialUpTo(stamp);
+    if (c.camera_pose) {
+      bag.write(c.camera_pose_topic, ros::Time(stamp),
+                cameraPoseMessage(run.camera_orientations[j], t0, c.target_frame, &pose_seq));
+    }
+    if (!c.images) continue;
     const int pose_a = run.trajectory.at(t - 0.5 * exposure).pose;
     const int pose_b = run.trajectory.at(t + 0.5 * exposure).pose;
     cv::Mat grey;
     if (pose_a >= 0 && pose_a == pose_b) {
       if (cached_pose != pose_a) {
-        cached = renderer.renderAt(run.trajectory, t, exposure);
+        cached = renderer->renderAt(run.trajectory, t, exposure);
         cached_pose = pose_a;
         ++rendered;
       }
       grey = cached;
     } else {
-      grey = renderer.renderAt(run.trajectory, t, exposure);
+      grey = renderer->renderAt(run.trajectory, t, exposure);
       ++rendered;
     }
     const cv::Mat mono = sim::ImageRenderer::toMono8(grey, c.noise_scale * c.pixel_noise_sigma,
@@ -242,8 +269,9 @@ int main(int argc, char** argv) {
     cia::SimulateBagOptions options = cia::parseSimulateBagOptions(args);
     // Bag topics are global names, as rosbag record writes them: `rosbag play --topics
     // /camera/image_raw` matches only "/camera/image_raw", not "camera/image_raw".
-    for (std::string* topic : {&options.config.imu_topic, &options.config.mag_topic,
-                               &options.config.image_topic, &options.config.camera_info_topic}) {
+    for (std::string* topic :
+         {&options.config.imu_topic, &options.config.mag_topic, &options.config.image_topic,
+          &options.config.camera_info_topic, &options.config.camera_pose_topic}) {
       if (!topic->empty() && (*topic)[0] != '/') *topic = "/" + *topic;
     }
     const std::string& out = options.out;
@@ -259,8 +287,10 @@ int main(int argc, char** argv) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::cout << "simulate_bag: wrote " << out << " (" << run.trajectory.duration() << " s, "
               << run.trajectory.poses().size() << " poses, " << run.imu.size() << " IMU, "
-              << run.mag.size() << " magnetometer, " << run.frame_times.size() << " images, "
-              << rendered << " rendered) in " << secs << " s\n"
+              << run.mag.size() << " magnetometer, " << (config.images ? run.frame_times.size() : 0)
+              << " images, " << rendered << " rendered, "
+              << (config.camera_pose ? run.camera_orientations.size() : 0) << " camera poses) in "
+              << secs << " s\n"
               << "simulate_bag: wrote " << base << ".truth.yaml and " << base << ".target.yaml\n";
     return 0;
   } catch (const cia::UsageError& e) {

@@ -157,7 +157,10 @@ const std::vector<Key>& simulateBagOptionTable() {
             }
             return false;
           },
-          [](sim::MotionKind k) { return sim::toString(k); }, "how the rig moves between poses"),
+          [](sim::MotionKind k) { return sim::toString(k); },
+          "how the rig moves between poses (--scenario waving: continuously, no poses)"),
+      number<double>("--duration-s", CIA_MEMBER(config.waving_duration_s), within(1, 3600), "s",
+                     "length of a --scenario waving run"),
       number<double>("--max-tilt-deg", CIA_MEMBER(config.max_tilt_deg), within(0, 60), "deg",
                      "viewing direction off the target normal"),
       number<double>("--max-roll-deg", CIA_MEMBER(config.max_roll_deg), within(0, 180), "deg",
@@ -297,6 +300,16 @@ const std::vector<Key>& simulateBagOptionTable() {
                   "samples per pixel along each axis"),
       number<double>("--motion-blur-s", CIA_MEMBER(config.motion_blur_exposure_s), within(0, 1),
                      "s", "> 0: frames in motion average renders over this exposure"),
+      flag(
+          "--no-images", [](Options* o) { o->config.images = false; },
+          "no Image / CameraInfo messages, nothing rendered (fast bags; with --camera-pose)"),
+      flag(
+          "--camera-pose", [](Options* o) { o->config.camera_pose = true; },
+          "write the camera in the target frame as geometry_msgs/PoseStamped at every frame "
+          "(stamped as the images, --camera-time-offset-s included)"),
+      number<double>("--camera-pose-noise-deg", CIA_MEMBER(config.camera_pose_noise_deg),
+                     within(0, 10), "deg",
+                     "1-sigma orientation noise per axis of --camera-pose (x --noise-scale)"),
       // ROS names, time base, bag.
       textKey<Options>("--imu-topic", CIA_MEMBER(config.imu_topic), "a topic name",
                        "IMU topic (a relative name is made global)"),
@@ -306,6 +319,10 @@ const std::vector<Key>& simulateBagOptionTable() {
                        "image topic"),
       textKey<Options>("--camera-info-topic", CIA_MEMBER(config.camera_info_topic), "a topic name",
                        "camera info topic"),
+      textKey<Options>("--camera-pose-topic", CIA_MEMBER(config.camera_pose_topic), "a topic name",
+                       "camera pose topic (--camera-pose)"),
+      textKey<Options>("--target-frame", CIA_MEMBER(config.target_frame), "a frame name",
+                       "frame_id of the camera pose messages (the target's)"),
       textKey<Options>("--imu-frame", CIA_MEMBER(config.imu_frame), "a frame name",
                        "frame_id of the IMU"),
       textKey<Options>("--camera-frame", CIA_MEMBER(config.camera_frame), "a frame name",
@@ -397,6 +414,10 @@ SimulateBagOptions parseSimulateBagOptions(const CliArgs& args) {
       (o.bag.mag_frame.empty() || o.bag.mag_frame == c.imu_frame)) {
     throw SettingsError(source, "--mag-frame-yaw-deg",
                         "--mag-frame-yaw-deg needs a --mag-frame other than the IMU's frame");
+  }
+  if (!c.images && !c.camera_pose) {
+    throw SettingsError(source, "--no-images",
+                        "--no-images leaves no camera data: add --camera-pose");
   }
   const std::string problems = sim::validateConfig(c);
   if (!problems.empty()) throw SettingsError(source, "", problems);

@@ -68,7 +68,8 @@ std::vector<MagSample> simulateMagnetometer(const SimulationConfig& config,
                                             const Trajectory& trajectory);
 
 /// The seed's independent random stream `stream` (0: mounting and poses, 1: IMU, 2: magnetometer,
-/// 3: disturbances, 4: image noise, 5: bad input, 6: systematic IMU errors).
+/// 3: disturbances, 4: image noise, 5: bad input, 6: systematic IMU errors, 7: camera orientation
+/// noise).
 std::uint64_t streamSeed(std::uint64_t seed, int stream);
 
 }  // namespace simulation

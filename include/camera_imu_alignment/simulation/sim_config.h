@@ -21,6 +21,8 @@ enum class MotionKind {
   kFull,        ///< roll, pitch and yaw diversity with some translation: all axes excited
   kSingleAxis,  ///< rotations about the optical axis only (degenerate: one axis unobservable)
   kSmallAngle,  ///< full motion but within a few degrees (poorly conditioned)
+  kWaving,      ///< continuous hand-held motion, no rests (waving_motion.h); num_poses, hold and
+                ///< move times unused, the run lasts waving_duration_s
 };
 
 enum class TargetType { kCheckerboard, kAprilgrid, kCirclegrid };
@@ -47,6 +49,7 @@ struct SimulationConfig {
   double max_tilt_deg = 35.0;                          ///< viewing direction off the target normal
   double max_roll_deg = 80.0;                          ///< rotation about the optical axis
   double min_distance_m = 0.55, max_distance_m = 0.9;  ///< camera to target centre
+  double waving_duration_s = 60.0;                     ///< length of a kWaving run
 
   // Mounting. Random per seed (at least 30 deg from the identity) unless given.
   bool given_R_cam_imu = false;
@@ -78,7 +81,11 @@ struct SimulationConfig {
   /// 15 Hz, a typical camera: the nominal 80 s run is then a ~380 MB bag (pixel noise defeats
   /// compression). Tests use --camera-rate-hz 5 (~130 MB, 15-25 frames per hold) for speed.
   double camera_rate_hz = 15.0;
-  double camera_time_offset_s = 0.0;    ///< image stamp = true capture time + offset
+  /// image stamp = true capture time + offset (Kalibr's timeshift_cam_imu = -offset)
+  double camera_time_offset_s = 0.0;
+  /// 1-sigma noise per axis (deg) of the camera orientations R_target_cam published as
+  /// camera_pose (cameraOrientations in simulation_run.h): R_true * Exp(n), n in the camera frame
+  double camera_pose_noise_deg = 0.02;
   double blur_sigma_px = 0.6;           ///< Gaussian optical blur
   double pixel_noise_sigma = 1.5;       ///< grey levels (0-255), before noise_scale
   int supersample = 3;                  ///< samples per pixel along each axis
@@ -97,7 +104,11 @@ struct SimulationConfig {
   std::string imu_topic = "imu/data_raw", mag_topic = "imu/mag";
   std::string image_topic = "camera/image_raw", camera_info_topic = "camera/camera_info";
   std::string imu_frame = "imu_link", camera_frame = "camera_optical_frame";
-  double start_time_s = 1700000000.0;  ///< bag time of the simulation's t = 0
+  bool images = true;        ///< write Image + CameraInfo messages (false: nothing is rendered)
+  bool camera_pose = false;  ///< write camera_orientations as geometry_msgs/PoseStamped
+  std::string camera_pose_topic = "camera_pose";
+  std::string target_frame = "calibration_target";  ///< frame_id of the camera_pose messages
+  double start_time_s = 1700000000.0;               ///< bag time of the simulation's t = 0
 };
 
 /// Scenario names with a one-line description each, in --help order.

@@ -1,7 +1,11 @@
-// One complete simulated run: trajectory, inertial/magnetic samples, camera frame times and the
-// bad-input plan, all determined by the configuration (seed included). Times are seconds since the
-// start of the run (bag time = config.start_time_s + t). Rendering is done per frame by the caller
-// (ImageRenderer), so a run costs little memory.
+// One complete simulated run: trajectory, inertial/magnetic samples, camera frame times, the
+// camera's orientation at every frame and the bad-input plan, all determined by the configuration
+// (seed included). Times are seconds since the start of the run (bag time = config.start_time_s +
+// t). Rendering is done per frame by the caller (ImageRenderer), so a run costs little memory, and
+// a run without images (IMU + camera orientations, e.g. for estimator unit tests) costs no
+// rendering at all:
+//   const SimulationRun run(config);   // run.imu, run.camera_orientations, run.trajectory
+//   run.trajectory.R_cam_imu_final()   // the truth
 #pragma once
 
 #include <string>
@@ -30,6 +34,23 @@ struct BadInputPlan {
   }
 };
 
+/// The camera's orientation at one frame, as a camera_pose message (geometry_msgs/PoseStamped,
+/// the camera in the target frame) carries it.
+struct CameraOrientation {
+  double capture_s = 0.0;  ///< true capture time (s since the start)
+  double stamp_s = 0.0;    ///< camera stamp: capture_s + config.camera_time_offset_s
+  /// Orientation with the noise: R_target_cam_true * Exp(n), n ~ N(0, sigma^2 I) in the camera
+  /// frame, sigma = config.noise_scale * config.camera_pose_noise_deg (random stream 7).
+  Eigen::Matrix3d R_target_cam = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d R_target_cam_true = Eigen::Matrix3d::Identity();  ///< at capture_s
+  Eigen::Vector3d p_target_cam = Eigen::Vector3d::Zero();           ///< true centre (m), no noise
+};
+
+/// The camera's orientation at every frame of `frame_times` (see CameraOrientation).
+std::vector<CameraOrientation> simulateCameraOrientations(const SimulationConfig& config,
+                                                          const Trajectory& trajectory,
+                                                          const std::vector<double>& frame_times);
+
 struct SimulationRun {
   SimulationConfig config;
   Trajectory trajectory;
@@ -38,6 +59,9 @@ struct SimulationRun {
   std::vector<MagDisturbance> disturbances;
   ImuErrors imu_errors;             ///< the unit's drawn errors (drawImuErrors(config))
   std::vector<double> frame_times;  ///< true capture times (s); stamps add camera_time_offset_s
+  /// The camera's orientation in the target frame at every frame (no rendering needed), stamped
+  /// as the images are: what simulate_bag --camera-pose publishes.
+  std::vector<CameraOrientation> camera_orientations;
   BadInputPlan bad_input;
 
   explicit SimulationRun(const SimulationConfig& c);

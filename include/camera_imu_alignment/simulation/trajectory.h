@@ -1,5 +1,6 @@
 // Ground-truth motion of the simulated rig: N stationary poses in front of a planar target fixed in
-// the world, joined by minimum-jerk rotation + translation segments, and the (possibly remounted)
+// the world, joined by minimum-jerk rotation + translation segments (or, for MotionKind::kWaving,
+// continuous hand-held motion without rests: waving_motion.h), and the (possibly remounted)
 // mounting R_cam_imu(t). Everything is analytic: orientation, body rate and acceleration are exact.
 //
 // Frames: world ENU (z up). Target frame as Kalibr's (x along the columns, y along the rows, z out
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "camera_imu_alignment/simulation/sim_config.h"
+#include "camera_imu_alignment/simulation/waving_motion.h"
 
 namespace camera_imu_alignment {
 namespace simulation {
@@ -42,7 +44,9 @@ class Trajectory {
 
   RigState at(double t) const;
   double duration() const { return duration_; }
+  /// The stationary poses in time order; empty for MotionKind::kWaving (no rests).
   const std::vector<StationaryPose>& poses() const { return poses_; }
+  bool waving() const { return waving_; }
 
   /// Mounting before any remount, and at the end of the run (equal without remount).
   const Eigen::Matrix3d& R_cam_imu_initial() const { return R_cam_imu_initial_; }
@@ -55,7 +59,11 @@ class Trajectory {
   const Eigen::Vector3d& p_world_target() const { return p_world_target_; }
 
  private:
+  RigState poseMotionAt(double t) const;  ///< camera motion of the pose scenarios (no mounting)
+
   std::vector<StationaryPose> poses_;
+  bool waving_ = false;
+  WavingMotion waving_motion_;
   double duration_ = 0.0;
   Eigen::Matrix3d R_cam_imu_initial_;
   bool remount_ = false;
