@@ -76,9 +76,17 @@ int countRemounts(const JointProblem& problem, const JointResult& whole,
   return verdicts;
 }
 
+/// How a wall-board run is solved: the default settings, or the unit's own priors
+/// (test::jointSettingsFor), with or without the motion between the rests.
+struct WallBoardSolve {
+  bool unit_priors = false;
+  bool motion = true;  ///< false: rests only (motion_window_s 0)
+};
+
 /// The wall_board session of `grade` for seeds 1..count; `systematic` false: the grade's noise
 /// only (T_g = T_a = I, no iron).
-WallBoardOutcome runWallBoard(sim::ImuGrade grade, bool systematic, int count) {
+WallBoardOutcome runWallBoard(sim::ImuGrade grade, bool systematic, int count,
+                              WallBoardSolve solve = {}) {
   WallBoardOutcome out;
   for (int k = 0; k < count; ++k) {
     sim::SimulationConfig c;
@@ -89,6 +97,8 @@ WallBoardOutcome runWallBoard(sim::ImuGrade grade, bool systematic, int count) {
     c.camera_rate_hz = 1.0;  // frames are given by the harness, not rendered
     const sim::SimulationRun run(c);
     PipelineSettings settings;
+    if (solve.unit_priors) settings.joint = test::jointSettingsFor(c);
+    if (!solve.motion) settings.motion_window_s = 0.0;
     const bool rendered = std::getenv("CIA_WALL_BOARD_RENDERED") != nullptr;
     test::PipelineRun rendered_run;
     std::unique_ptr<CalibrationPipeline> fed;
@@ -163,12 +173,13 @@ void expectHonest(const WallBoardOutcome& o) {
   EXPECT_EQ(o.remounts, 0);
 }
 
-// Measured 2026-11-26 (seeds 1-20): RMS 0.0795 deg, max 0.133, |z| <= 1.56, reported 1-sigma norm
-// 0.108 RMS; T_a determined by the data in 20/20 (before: "held at its prior: gravity direction
-// spread 0.050-0.123 < 0.100" in most). The issue's target of 0.06 deg RMS is not met: the error is
-// the information the session carries (with T_g known exactly 0.020, with T_a known 0.028, with the
-// soft iron known 0.045), and the reported 1-sigma says so. Asserted: the max target (0.15) and
-// 3 sigma, RMS within 0.10.
+// Measured 2026-11-26 (seeds 1-20), rests only: RMS 0.0795 deg, max 0.133, |z| <= 1.56, reported
+// 1-sigma norm 0.108 RMS; with the motion between the rests (motion nodes, the default since issue
+// 25): RMS 0.0755, max 0.141, |z| <= 1.56, 1-sigma norm 0.108; T_a determined by the data in 20/20
+// (before: "held at its prior: gravity direction spread 0.050-0.123 < 0.100" in most). The issue's
+// target of 0.06 deg RMS is not met: the error is the information the session carries (with T_g
+// known exactly 0.020, with T_a known 0.028, with the soft iron known 0.045), and the reported
+// 1-sigma says so. Asserted: the max target (0.15) and 3 sigma, RMS within 0.10.
 TEST(WallBoardSessions, ConsumerGradeWithSystematicErrors) {
   const WallBoardOutcome o = runWallBoard(sim::ImuGrade::kConsumer, true, seedCount());
   expectHonest(o);
@@ -177,26 +188,47 @@ TEST(WallBoardSessions, ConsumerGradeWithSystematicErrors) {
   EXPECT_GE(o.accel_matrix_determined, o.runs * 9 / 10);
 }
 
-// Measured: RMS 0.0192 deg, max 0.033, |z| <= 2.18 (T_g = T_a = I kept by the model selection in
-// 20/20). Target: <= 0.04 deg RMS within 3 sigma.
+// Measured, rests only: RMS 0.0192 deg, max 0.033, |z| <= 2.18 (T_g = T_a = I kept by the model
+// selection in 20/20); with the motion: RMS 0.0149, max 0.021, |z| <= 1.66. Target: <= 0.04 deg
+// RMS within 3 sigma.
 TEST(WallBoardSessions, ConsumerNoiseWithoutSystematicErrors) {
   const WallBoardOutcome o = runWallBoard(sim::ImuGrade::kConsumer, false, seedCount());
   expectHonest(o);
   EXPECT_LT(o.rms(), 0.04);
 }
 
-// Measured: tactical RMS 0.0254 deg (max 0.051, |z| <= 0.72); noisy RMS 0.337 (max 0.564,
-// |z| <= 2.62).
+// Measured: tactical RMS 0.0254 deg (max 0.051, |z| <= 0.72), with the motion 0.0258 (max 0.056,
+// |z| <= 0.68).
 TEST(WallBoardSessions, TacticalGrade) {
   const WallBoardOutcome o = runWallBoard(sim::ImuGrade::kTactical, true, seedCount());
   expectHonest(o);
   EXPECT_LT(o.rms(), 0.04);
 }
 
+// The noisy unit (MPU-6050 class: gyro and accelerometer scale 3 %, cross-axis 2 %, accelerometer
+// bias 0.6 m/s^2, hard iron 40 uT) is 2-3x outside the default (consumer) priors; it is solved with
+// its own (test::jointSettingsFor), as its users are told to. Measured: RMS 0.315 deg (max 0.596,
+// |z| <= 2.74). Under the default priors, rests only: RMS 0.337 (max 0.564, |z| <= 2.62); with the
+// motion the errors are the same (RMS 0.342) but the 1-sigma 25 % smaller and seed 18 at 3.36
+// sigma: the motion nodes tie R_cam_imu to a gyro model whose priors are too narrow.
 TEST(WallBoardSessions, NoisyGrade) {
-  const WallBoardOutcome o = runWallBoard(sim::ImuGrade::kNoisy, true, seedCount());
+  WallBoardSolve solve;
+  solve.unit_priors = true;
+  const WallBoardOutcome o = runWallBoard(sim::ImuGrade::kNoisy, true, seedCount(), solve);
   expectHonest(o);
   EXPECT_LT(o.rms(), 0.45);
+}
+
+// Issue 25: the motion between the rests never makes the answer worse than the rests alone
+// (Monte Carlo RMS over the same seeds; measured 0.0755 against 0.0795 deg).
+TEST(WallBoardSessions, TheMotionBetweenTheRestsNeverMakesTheAnswerWorse) {
+  WallBoardSolve rests_only;
+  rests_only.motion = false;
+  const WallBoardOutcome with_motion = runWallBoard(sim::ImuGrade::kConsumer, true, seedCount());
+  const WallBoardOutcome without =
+      runWallBoard(sim::ImuGrade::kConsumer, true, seedCount(), rests_only);
+  EXPECT_LE(with_motion.rms(), without.rms() * 1.02);
+  EXPECT_LE(with_motion.max_deg, without.max_deg * 1.25);
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "joint_motion.h"
 
+#include "joint_state.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -174,7 +176,7 @@ ExpandedProblem expandMotion(const JointProblem& problem, const JointSettings& s
       }
       continue;
     }
-    const double from = a.end_s, to = b.start_s;
+    const double from = linkTime(a), to = linkTime(b);
     const bool linked = to - from <= settings.motion_max_link_s &&
                         covers(gyro, from - kSampleMargin, to + kSampleMargin, max_gap);
     if (!linked) {

@@ -81,6 +81,14 @@ bool whiteningMatrix(const Eigen::Matrix3d& covariance, double floor_sigma,
 bool computeWhitening(const JointProblem& problem, const std::vector<GyroPreintegration>& segments,
                       const JointSettings& settings, Whitening* whitening, std::string* error);
 
+/// Where a gyro link around a motion node (GyroSegment::interval) starts or ends at this pose: a
+/// rest's middle (the IMU is at rest there, whatever the stationary detector's lag at the rest's
+/// ends; the bias the rest measures holds over it), a node's stamp (IMU clock at the initial
+/// offset).
+inline double linkTime(const JointPose& pose) {
+  return pose.at_rest ? 0.5 * (pose.start_s + pose.end_s) : pose.start_s;
+}
+
 /// True when a segment has a motion node at an end (then the time offset is estimated).
 bool hasMotionSegments(const JointProblem& problem);
 

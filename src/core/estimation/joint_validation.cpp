@@ -118,7 +118,7 @@ std::string validateSegment(const GyroSegment& segment, size_t j, const JointPro
     }
   }
   if (segment.interval &&
-      (segment.stamps_s.front() > from.end_s || segment.stamps_s.back() < to.start_s)) {
+      (segment.stamps_s.front() > linkTime(from) || segment.stamps_s.back() < linkTime(to))) {
     return name + ": its samples do not cover the interval between its poses";
   }
   if (segment.stamps_s.back() - segment.stamps_s.front() > 3600.0) {
@@ -267,8 +267,8 @@ std::vector<GyroPreintegration> preintegrateSegments(const JointProblem& problem
                                      T_g, biases[segment.from_pose], biases[segment.to_pose]));
       continue;
     }
-    const double t_from = from.end_s + (from.at_rest ? 0.0 : shift);
-    const double t_to = to.start_s + (to.at_rest ? 0.0 : shift);
+    const double t_from = linkTime(from) + (from.at_rest ? 0.0 : shift);
+    const double t_to = linkTime(to) + (to.at_rest ? 0.0 : shift);
     Eigen::Vector3d rate_from, rate_to;
     out.push_back(preintegrateGyroInterval(segment.stamps_s, segment.gyro_rad_s, t_from, t_to, T_g,
                                            biases[segment.from_pose], biases[segment.to_pose],

@@ -76,7 +76,7 @@ struct OnlineCalibrator::Impl {
   void onPoseRejected(const RejectedPose& rejected);
   void checkPairRemount(const StationaryPose& pose);
   void requestSolve();
-  /// Continuous motion: a solve every kMotionFramesPerSolve new motion frames.
+  /// Continuous motion: a solve after kMotionFramesPerSolve motion frames without one.
   void onMotionFrames();
   std::uint64_t motion_frames_solved = 0;  ///< pipeline->motionFrames() at the last such solve
   void poll();
@@ -181,6 +181,7 @@ void OnlineCalibrator::Impl::restartWindowAt(int first_index, int kept_index, do
 }
 
 void OnlineCalibrator::Impl::requestSolve() {
+  motion_frames_solved = pipeline->motionFrames();
   SolveJob job;
   job.generation = generation;
   job.window = pipeline->snapshot();
@@ -196,7 +197,6 @@ void OnlineCalibrator::Impl::onMotionFrames() {
   constexpr std::uint64_t kMotionFramesPerSolve = 100;  // 5 s at 20 Hz
   const std::uint64_t frames = pipeline->motionFrames();
   if (frames < motion_frames_solved + kMotionFramesPerSolve) return;
-  motion_frames_solved = frames;
   requestSolve();
 }
 

@@ -324,7 +324,7 @@ void CalibrationPipeline::Impl::processMotionFrame(const CameraFrame& frame) {
         frame.mono8.rows != intrinsics->height) {
       return;  // counted and said by the rests' frames
     }
-    ++num_detected;
+    ++motion_detections;
     const Eigen::Matrix3d* hint =
         motion_frames.empty() ? nullptr : &motion_frames.back().R_target_cam;
     TargetObservation observation;

@@ -92,6 +92,7 @@ struct CalibrationPipeline::Impl {
   std::deque<std::pair<double, Eigen::Vector3d>> motion_gyro;  ///< raw gyro (stamp, rad/s)
   double last_motion_frame_stamp = -std::numeric_limits<double>::infinity();
   std::uint64_t motion_frames_total = 0;
+  std::uint64_t motion_detections = 0;  ///< frames during motion on which detection ran
 
   std::size_t poses_total = 0, rests_total = 0;
   std::uint64_t imu_gaps = 0;  ///< IMU stamp gaps longer than settings.stationary.max_gap_s
