@@ -148,6 +148,13 @@ bool runVisp(VispOutcome* out) {
     std::printf("pose %d: %d frames, reprojection %.2f px, camera spread %.4f deg\n", pose.index,
                 pose.num_frames, pose.reprojection_rms_px, pose.camera_spread_deg);
   }
+  // ViSP's intrinsics are right for these images: the camera-model check must not name them.
+  const CameraModelCheck camera = pipeline.cameraModelCheck();
+  std::printf("camera model: %d views, focal factor %.4f +- %.4f (p %.3g), median view p %.3g\n",
+              camera.views, camera.focal_scale, camera.focal_scale_sigma, camera.p_value,
+              camera.view_p_value);
+  EXPECT_TRUE(camera.tested);
+  EXPECT_FALSE(camera.wrong) << camera.message;
   out->result = solveWindow(pipeline.snapshot(), pipeline.settings());
   if (out->result.status != SolveStatus::kOk || !out->result.joint || !out->result.joint->ok) {
     ADD_FAILURE() << out->result.message;

@@ -350,6 +350,7 @@ void AlignmentWrapper::Impl::diagnose(diagnostic_updater::DiagnosticStatusWrappe
                        std::to_string(snap.inputs.frames_detected) +
                        " frames at rest: does target_file describe the board in view?");
   }
+  if (snap.camera_model.wrong) problems.push_back(snap.camera_model.message);
   if (snap.latest && snap.latest->result.joint && !snap.latest->result.joint->ok) {
     problems.push_back(
         "the joint estimate failed (" + snap.latest->result.joint->message + ")" +
@@ -375,6 +376,9 @@ void AlignmentWrapper::Impl::diagnose(diagnostic_updater::DiagnosticStatusWrappe
   status.add("poses in window", snap.window.size());
   status.add("remounts", snap.remounts);
   status.add("imu gaps", snap.inputs.imu_gaps);
+  status.add("camera model", !snap.camera_model.tested ? std::string("not tested yet")
+                             : snap.camera_model.wrong ? snap.camera_model.message
+                                                       : std::string("fits the images"));
   // One key per reason, zeros included, so that monitors can track each.
   const RejectionCounts& rejections = snap.rejections;
   status.add("rejected inputs", rejections.summary());

@@ -1,7 +1,8 @@
 // calibrate_bag: R_cam_imu from a rosbag of a camera + IMU (+ magnetometer) rig, offline, without a
 // roscore. Reads the bag with the rosbag C++ API and drives the core CalibrationPipeline (the same
 // class the nodelet drives). Exit codes (doc/CONVENTIONS.md): 0 success; 2 bad input or usage
-// (unreadable or truncated bag, missing topic, no camera data, bad target file); 3 not enough
+// (unreadable or truncated bag, missing topic, no camera data, bad target file, camera_info
+// intrinsics that do not fit the images); 3 not enough
 // information (too few poses, not observable: the message names the axis to rotate about); 4 the
 // estimate fails the quality gates or the mount moved during the recording. The bag is read by
 // bag_reader.h.
@@ -90,7 +91,8 @@ const char* kUsage =
     "                        mount after the last change (named in the verdict) instead of\n"
     "                        exiting 4\n"
     "  --quiet               no progress on stderr\n"
-    "exit codes: 0 success, 2 bad input or usage, 3 not enough information (the message says what\n"
+    "exit codes: 0 success, 2 bad input or usage (also: camera_info's intrinsics do not fit the\n"
+    "images), 3 not enough information (the message says what\n"
     "motion is missing), 4 an estimate that fails the quality gates or a mount that moved during\n"
     "the recording (the verdict line says which; nothing is written)\n";
 
@@ -301,6 +303,7 @@ int run(const cia::CliArgs& args) {
   for (const cia::RemountEvent& e : snap.remount_events) {
     std::cout << "remount: " << e.message << "\n";
   }
+  if (snap.camera_model.wrong) std::cout << "camera_info: " << snap.camera_model.message << "\n";
   if (args.has("--report")) {
     std::string error;
     if (!cia::writeReportPng(args.get("--report"), report, &error)) {
@@ -315,6 +318,12 @@ int run(const cia::CliArgs& args) {
       std::cerr << "calibrate_bag: --export-poses " << e.what() << "\n";
       return kExitBadInput;
     }
+  }
+  if (snap.camera_model.wrong) {  // camera_info, not the recording: every pose is biased by it
+    std::cerr << "calibrate_bag: "
+              << (topics.camera_info.empty() ? std::string("camera info") : topics.camera_info)
+              << ": " << snap.camera_model.message << "\n";
+    return kExitBadInput;
   }
   const cia::SolveStatus status = report.result.status;
   if (status != cia::SolveStatus::kOk) {

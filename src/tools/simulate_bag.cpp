@@ -68,15 +68,17 @@ bool contains(const std::vector<long>& v, long i) {
   return std::binary_search(v.begin(), v.end(), i);
 }
 
-sensor_msgs::CameraInfo cameraInfo(const sim::SimulationConfig& c) {
+/// The CameraInfo of the rendering camera, its focal lengths times `focal_scale`.
+sensor_msgs::CameraInfo cameraInfo(const sim::SimulationConfig& c, double focal_scale) {
+  const double fx = focal_scale * c.fx, fy = focal_scale * c.fy;
   sensor_msgs::CameraInfo info;
   info.width = c.width;
   info.height = c.height;
   info.distortion_model = "plumb_bob";
   info.D.assign(c.distortion.begin(), c.distortion.end());
-  info.K = {c.fx, 0.0, c.cx, 0.0, c.fy, c.cy, 0.0, 0.0, 1.0};
+  info.K = {fx, 0.0, c.cx, 0.0, fy, c.cy, 0.0, 0.0, 1.0};
   info.R = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
-  info.P = {c.fx, 0.0, c.cx, 0.0, 0.0, c.fy, c.cy, 0.0, 0.0, 0.0, 1.0, 0.0};
+  info.P = {fx, 0.0, c.cx, 0.0, 0.0, fy, c.cy, 0.0, 0.0, 0.0, 1.0, 0.0};
   return info;
 }
 
@@ -198,7 +200,7 @@ int writeBag(const sim::SimulationRun& run, const std::string& path, const BagOp
   };
 
   // Camera frames; a stationary pose is rendered once and only the pixel noise changes.
-  const sensor_msgs::CameraInfo info_template = cameraInfo(c);
+  const sensor_msgs::CameraInfo info_template = cameraInfo(c, options.camera_info_focal_scale);
   const double exposure = c.motion_blur_exposure_s;
   int rendered = 0, cached_pose = -1;
   cv::Mat cached;

@@ -292,6 +292,10 @@ const std::vector<Key>& simulateBagOptionTable() {
             std::copy(v.begin(), v.end(), o->config.distortion.begin());
           },
           "5 numbers k1,k2,p1,p2,k3", "", "plumb_bob distortion"),
+      number<double>("--camera-info-focal-scale", CIA_MEMBER(bag.camera_info_focal_scale),
+                     within(0.1, 10), "",
+                     "CameraInfo's fx, fy = the true ones times this (1: true; else a wrong "
+                     "camera_info; the truth file keeps the true K)"),
       number<double>("--blur-sigma-px", CIA_MEMBER(config.blur_sigma_px), within(0, 10), "px",
                      "Gaussian optical blur"),
       number<double>("--pixel-noise", CIA_MEMBER(config.pixel_noise_sigma), within(0, 100),

@@ -18,6 +18,9 @@ struct BagOptions {
   std::string compression = "none";  ///< none, lz4 or bz2
   std::string mag_frame;             ///< frame_id of the magnetometer; empty: the IMU's
   double mag_frame_yaw_rad = 0.0;    ///< R_imu_mag = rotation about the IMU's z by this angle
+  /// The CameraInfo's fx, fy are the rendering camera's times this (1: the true ones; else a wrong
+  /// camera_info, as written by a bad camera calibration). The truth file keeps the true K.
+  double camera_info_focal_scale = 1.0;
 };
 
 /// Everything simulate_bag's options set.

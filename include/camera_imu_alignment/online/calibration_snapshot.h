@@ -28,6 +28,9 @@ struct EstimateEvent {
   std::size_t window_poses = 0;  ///< poses the estimate used
   bool forced = false;           ///< broadcast on request although a gate failed
   std::optional<MountChangeTest> mount_test;
+  /// "" unless camera_info's model did not fit the images when it was judged
+  /// (CameraModelCheck::message): the gate rejects it and the verdict names camera_info.
+  std::string camera_model_problem;
 };
 
 /// A mount change found.
@@ -49,7 +52,9 @@ struct CalibrationVerdict {
 };
 
 /// The verdict of a solved estimate (none when it is not solved and observable: the estimate's own
-/// message says what is missing) given the remounts found since the start or the last reset. With
+/// message says what is missing) given the remounts found since the start or the last reset. A
+/// camera model that does not fit the images (EstimateEvent::camera_model_problem) fails it first,
+/// naming camera_info: its poses are biased, and so is any remount or axis they suggest. With
 /// `accept_last_mount` (calibrate_bag --accept-last-mount) a remount does not fail it: the estimate
 /// is the last mount's, from the poses after the change, and the verdict names the change.
 std::optional<CalibrationVerdict> recordingVerdict(const EstimateEvent& estimate,
@@ -109,6 +114,9 @@ struct CalibrationSnapshot {
   /// "" unless the target was never found at rest (CalibrationPipeline::targetNotFoundDiagnosis):
   /// what is wrong with the target file.
   std::string target_diagnosis;
+  /// Does camera_info's model fit the images (CalibrationPipeline::cameraModelCheck)? When it does
+  /// not (camera_model.wrong), `message` is its message and no remount is declared.
+  CameraModelCheck camera_model;
 
   // --- poses
   std::size_t rests_total = 0, poses_total = 0;  ///< since the start or the last reset

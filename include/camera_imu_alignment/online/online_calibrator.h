@@ -19,6 +19,9 @@
 //     estimate is judged without the old one as a reference.
 //   pair modes: remount_poses consecutive new poses whose pairs disagree with the broadcast
 //     estimate by more than remount_residual_deg restart the window from them.
+// Neither is declared while camera_info's model does not fit the images
+// (CalibrationPipeline::cameraModelCheck): a wrong focal length bends every pose as a remount
+// would. Then no estimate is broadcast, the verdict and the snapshot's message name camera_info.
 // A clock jump back (a bag loop, a restarted simulation) clears the window and the buffers; the
 // broadcast estimate stays.
 #pragma once

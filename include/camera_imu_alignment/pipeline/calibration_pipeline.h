@@ -66,6 +66,7 @@
 #include "camera_imu_alignment/solver/alignment_solver.h"
 #include "camera_imu_alignment/solver/pose_window.h"
 #include "camera_imu_alignment/vision/camera_model.h"
+#include "camera_imu_alignment/vision/camera_model_check.h"
 #include "camera_imu_alignment/vision/camera_pose.h"
 #include "camera_imu_alignment/vision/target_detector.h"
 
@@ -245,6 +246,11 @@ class CalibrationPipeline : public SampleSink {
   /// found one of another size (TargetObservation::mismatch).
   std::string targetNotFoundDiagnosis() const;
   bool hasIntrinsics() const;
+  /// Significance level of each of cameraModelCheck()'s two tests.
+  static constexpr double kCameraModelLevel = 1e-4;
+  /// Does camera_info's model fit the frames at rest (vision/camera_model_check.h)? One view per
+  /// rest, from every frame whose target was detected (its pose accepted or refused).
+  CameraModelCheck cameraModelCheck() const;
   const PipelineSettings& settings() const;
 
  private:

@@ -16,7 +16,15 @@ std::optional<CalibrationVerdict> recordingVerdict(const EstimateEvent& estimate
   const bool gates_passed = estimate.gate.decision != GateDecision::kReject;
   CalibrationVerdict verdict;
   verdict.passed = gates_passed && (remounts.empty() || accept_last_mount);
-  if (!remounts.empty() && accept_last_mount) {
+  if (!estimate.camera_model_problem.empty()) {
+    verdict.passed = false;
+    verdict.text = "FAILED: " + estimate.camera_model_problem;
+    if (!remounts.empty()) {
+      verdict.text += "; the mount change reported before pose " +
+                      std::to_string(remounts.front().first_pose_index) +
+                      " may be this model's error, not a remount";
+    }
+  } else if (!remounts.empty() && accept_last_mount) {
     const RemountEvent& last = remounts.back();
     char change[160];
     std::snprintf(change, sizeof(change), "the mount changed before pose %d (by %.2f deg)",

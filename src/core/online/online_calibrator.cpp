@@ -142,7 +142,7 @@ void OnlineCalibrator::Impl::onPoseRejected(const RejectedPose& rejected) {
 }
 
 void OnlineCalibrator::Impl::checkPairRemount(const StationaryPose& pose) {
-  if (!broadcast) return;
+  if (!broadcast || pipeline->cameraModelCheck().wrong) return;
   // The new pose's pairs with the rest of the window against the broadcast estimate.
   const RotationPairs pairs = pipeline->windowPairs();
   int newest = -1;
@@ -208,7 +208,9 @@ void OnlineCalibrator::Impl::poll() {
 void OnlineCalibrator::Impl::apply(SolveOutput output) {
   if (output.generation != generation) return;  // the window lost poses since: stale
   if (output.result.status == SolveStatus::kBadInput) return;
-  if (output.mount_test && output.mount_test->detected) {
+  // A camera model that does not fit the images biases the poses as a remount would: no remount
+  // is declared then (the estimate is refused, naming camera_info).
+  if (output.mount_test && output.mount_test->detected && !pipeline->cameraModelCheck().wrong) {
     applyRemount(output);
     return;
   }
@@ -223,8 +225,13 @@ EstimateEvent OnlineCalibrator::Impl::judged(SolveOutput output) const {
   event.gate = judgeEstimate(event.result, event.window_poses, settings, broadcast, fresh_start);
   // The gate's consistency verdict travels with the result: the YAML and the report print it.
   if (event.result.joint) event.result.joint->consistency_level = settings.consistency_level;
-  if (event.mount_test && event.mount_test->pending &&
-      event.gate.decision == GateDecision::kBroadcast) {
+  const CameraModelCheck camera_model = pipeline->cameraModelCheck();
+  if (camera_model.wrong) {  // the poses are biased: neither broadcast nor a remount verdict
+    event.camera_model_problem = camera_model.message;
+    event.gate.decision = GateDecision::kReject;
+    event.gate.why = camera_model.message;
+  } else if (event.mount_test && event.mount_test->pending &&
+             event.gate.decision == GateDecision::kBroadcast) {
     // The newest pose disagrees with the window as a remount would: an estimate over both mounts
     // (or with a bad pose) is not broadcast; the next pose decides.
     event.gate.decision = GateDecision::kReject;
@@ -469,6 +476,8 @@ CalibrationSnapshot OnlineCalibrator::snapshot(SnapshotContents contents) const 
   s.newest_stamp_s = c.clock.newest();
   s.inputs = inputCounts();
   s.target_diagnosis = p.targetNotFoundDiagnosis();
+  s.camera_model = p.cameraModelCheck();
+  if (s.camera_model.wrong) s.message = s.camera_model.message;  // what the user must fix first
   s.rejections = p.rejections();
   s.rests_total = p.restsTotal();
   s.poses_total = p.posesTotal();
@@ -484,7 +493,11 @@ CalibrationSnapshot OnlineCalibrator::snapshot(SnapshotContents contents) const 
   s.latest_is_broadcast = c.last_estimate && c.broadcast &&
                           rad2deg(rotationAngle(c.broadcast->R_cam_imu.transpose() *
                                                 c.last_estimate->result.R_cam_imu)) <= 1e-9;
-  if (c.last_estimate) s.verdict = recordingVerdict(*c.last_estimate, c.remount_events);
+  if (c.last_estimate) {
+    EstimateEvent latest = *c.last_estimate;  // judged again: the check may have fired since
+    if (s.camera_model.wrong) latest.camera_model_problem = s.camera_model.message;
+    s.verdict = recordingVerdict(latest, c.remount_events);
+  }
   s.remount_events = c.remount_events;
   if (c.last_estimate && c.broadcast) {
     s.check = checkCalibration(c.last_estimate->result, *c.broadcast, c.settings.consistency_level);

@@ -297,9 +297,14 @@ void CalibrationPipeline::Impl::processFrame(const CameraFrame& frame) {
     reject(RejectReason::kTargetNotFound, InputStream::kImage, out.str());
     return;
   }
+  // What the frame says about the camera model, whatever becomes of its pose.
+  if (const auto fit = fitCameraModel(observation, target, *intrinsics)) {
+    camera_model.addFrame(frame.stamp_s, *fit);
+  }
   std::string why;
   const auto pose = estimateCameraPose(observation, target, *intrinsics, settings.pose, &why);
   if (!pose) {
+    camera_model.addRefused(frame.stamp_s, why);
     reject(RejectReason::kPoseRejected, InputStream::kImage,
            "image at " + formatStamp(frame.stamp_s) + " s: " + why);
     return;
@@ -423,6 +428,10 @@ std::string CalibrationPipeline::targetNotFoundDiagnosis() const {
                     " frames at rest: does the target file describe the board in view?";
   if (!impl_->target_mismatch.empty()) out += " " + impl_->target_mismatch;
   return out;
+}
+CameraModelCheck CalibrationPipeline::cameraModelCheck() const {
+  const CameraIntrinsics* intrinsics = impl_->intrinsics ? &*impl_->intrinsics : nullptr;
+  return impl_->camera_model.check(kCameraModelLevel, intrinsics);
 }
 std::uint64_t CalibrationPipeline::framesDetected() const { return impl_->num_detected; }
 bool CalibrationPipeline::hasIntrinsics() const { return impl_->intrinsics.has_value(); }

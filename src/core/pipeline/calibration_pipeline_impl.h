@@ -10,6 +10,7 @@
 
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
 #include "camera_imu_alignment/pipeline/stationary_window.h"
+#include "camera_model_monitor.h"
 #include "rest_statistics.h"
 
 namespace camera_imu_alignment {
@@ -67,6 +68,8 @@ struct CalibrationPipeline::Impl {
   std::uint64_t num_imu = 0, num_mag = 0, num_frames = 0, num_detected = 0;
   std::uint64_t frames_without_intrinsics = 0, frames_dropped = 0;
   std::string target_mismatch;  ///< the detector's latest TargetObservation::mismatch
+  /// What the frames at rest say about camera_info's model (every detection, pose or not).
+  CameraModelMonitor camera_model{CalibrationPipeline::kHistoryLimit};
 
   // --- IMU orientation chain (see the rule in calibration_pipeline.h)
   bool chain_valid = false;

@@ -289,6 +289,8 @@ std::string CalibrationPipeline::Impl::assessCamera(const StationarySegment& seg
     if (d.stamp_s > segment.end_s) later.push_back(d);
   }
   detections.swap(later);
+  const int refused = camera_model.refusedIn(lo, hi);  // target seen, pose refused
+  const std::string refused_text = camera_model.endRest(lo, hi, segment.end_s);
 
   if (static_cast<int>(rotations.size()) < settings.min_frames_per_pose) {
     // Nothing arrived at all: the caller may name the silent topic (kNoCameraDataReason). Images
@@ -298,8 +300,9 @@ std::string CalibrationPipeline::Impl::assessCamera(const StationarySegment& seg
       return "no camera info received yet (" + std::to_string(frames_without_intrinsics) +
              " image(s) waiting for it)";
     }
-    std::string out = "target seen in " + std::to_string(rotations.size()) + " frame(s), " +
-                      std::to_string(settings.min_frames_per_pose) + " needed";
+    std::string out = "target seen in " + std::to_string(rotations.size() + refused) +
+                      " frame(s), " + std::to_string(settings.min_frames_per_pose) +
+                      (refused > 0 ? " with a camera pose needed; " + refused_text : " needed");
     if (!target_mismatch.empty()) out += " (" + target_mismatch + ")";
     return out;
   }
