@@ -92,7 +92,12 @@ struct CalibrationPipeline::Impl {
 
   // --- continuous motion (settings.motion_window_s > 0)
   std::deque<MotionFrame> motion_frames;  ///< frames outside the rests with a camera orientation
-  std::deque<std::pair<double, Eigen::Vector3d>> motion_gyro;  ///< raw gyro (stamp, rad/s)
+  /// Raw IMU samples during the motion window: stamp, gyro (rad/s), accelerometer (m/s^2).
+  struct RawImu {
+    double stamp_s;
+    Eigen::Vector3d gyro_rad_s, accel_m_s2;
+  };
+  std::deque<RawImu> motion_gyro;
   double last_motion_frame_stamp = -std::numeric_limits<double>::infinity();
   std::uint64_t motion_frames_total = 0;
   std::uint64_t motion_detections = 0;  ///< frames during motion on which detection ran
