@@ -1,11 +1,11 @@
 // Recordings without rests (issue 25): the cost of continuous-motion calibration on one core.
-//   BM_MotionWindowSolve: solveWindow on the final window of a 60 s waving recording with 1200
+//   BM_MotionWindowSolve: solveWindow on the final window of a 60 s waving recording with 1201
 //     camera frames (20 Hz, all kept: motion_frame_interval_s 0.05): the coarse time offset, the
 //     motion pairs and pair solvers, and the joint estimate with its motion nodes and time offset.
 //     Target: <= 2 s. Counters: frames, nodes (motion nodes used), joint_ms (the joint estimator's
 //     own solve_time_s), err_deg (against the truth), dt_ms (time offset error).
 //   BM_MotionPipelineIngest: the same recording (12000 IMU samples, 6000 magnetometer samples,
-//     1200 camera orientations) fed to a new CalibrationPipeline, no solve: samples_per_s.
+//     1201 camera orientations) fed to a new CalibrationPipeline, no solve: samples_per_s.
 //   BM_MotionOnlineCalibrator: the same fed to an OnlineCalibrator solving on the caller's thread
 //     (a motion solve every 100 motion frames) and calibrateNow at the end: the whole recording's
 //     compute as calibrate_bag spends it. Counters: solves, realtime_factor (60 s of data over the
