@@ -37,6 +37,6 @@ struct TimeshiftSearch {
 double gyroNoiseDensityOf(const GyroStream& gyro);
 
 TimeshiftSearch coarseTimeshift(const std::vector<MotionFrame>& frames, const GyroStream& gyro,
-                                double range_s, double max_interval_s = 0.2);
+                                double range_s, double max_interval_s = 0.35);
 
 }  // namespace camera_imu_alignment
