@@ -20,6 +20,9 @@ constexpr double kSampleMargin = 0.25;
 /// Motion frames this close (s, IMU clock) to a rest are left out: the rest's own camera average
 /// already holds them.
 constexpr double kRestGuard = 0.05;
+/// Stamps differing by less than this (s) from a node spacing count as that spacing: a 10 Hz
+/// camera's frames 0.1 s apart (in floating point, 0.0999999...) are all nodes, not every other.
+constexpr double kSpacingToleranceS = 1e-4;
 
 /// The samples of `gyro` within [from - margin, to + margin].
 void copySamples(const GyroStream& gyro, double from, double to, GyroSegment* segment) {
@@ -193,7 +196,7 @@ ExpandedProblem expandMotion(const JointProblem& problem, const JointSettings& s
   for (size_t f = 0; f < problem.motion_frames.size(); ++f) {
     const MotionFrame& frame = problem.motion_frames[f];
     const double t = frame.stamp_s + shift;
-    if (t - last < settings.motion_node_spacing_s) continue;
+    if (t - last < settings.motion_node_spacing_s - kSpacingToleranceS) continue;
     bool in_rest = false;
     for (const JointPose& rest : problem.poses) {
       in_rest = in_rest || (t > rest.start_s - kRestGuard && t < rest.end_s + kRestGuard);

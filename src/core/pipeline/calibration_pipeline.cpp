@@ -315,7 +315,10 @@ void CalibrationPipeline::Impl::processFrame(const CameraFrame& frame) {
 }
 
 void CalibrationPipeline::Impl::processMotionFrame(const CameraFrame& frame) {
-  if (frame.stamp_s - last_motion_frame_stamp < settings.motion_frame_interval_s) return;
+  if (frame.stamp_s - last_motion_frame_stamp <
+      settings.motion_frame_interval_s - kMotionIntervalToleranceS) {
+    return;
+  }
   MotionFrame motion;
   motion.stamp_s = frame.stamp_s;
   if (frame.R_target_cam) {

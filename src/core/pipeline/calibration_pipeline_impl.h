@@ -17,6 +17,10 @@ namespace camera_imu_alignment {
 
 /// 1-sigma (deg per axis) assumed for a camera orientation given without covariance (camera_pose).
 constexpr double kGivenOrientationSigmaDeg = 0.05;
+/// Frames during motion differing by less than this (s) from motion_frame_interval_s count as
+/// that far apart: a 20 Hz camera's frames (0.05 s apart, in floating point 0.0499999...) are all
+/// kept with the default 0.05 s, not two of every three.
+constexpr double kMotionIntervalToleranceS = 1e-4;
 
 /// Camera pose of one frame taken at rest.
 struct FrameDetection {
