@@ -156,12 +156,19 @@ TEST(JointPipeline, ConsumerGradeWithSystematicErrors) {
   expectHonestSigma(o);
 }
 
+// With the motion between the rests (motion nodes, issue 25) the tactical unit's estimate rests
+// mostly on the camera orientations during motion, which this harness gives as camera_pose-style
+// orientations with 0.03 deg of noise while the pipeline, which cannot know it, assumes 0.05
+// (kGivenOrientationSigmaDeg): its 1-sigma is conservative, 56 of 60 axes within 1 sigma
+// (0.0192 deg RMS, max 0.059; rests only: 0.0190, max 0.037). Measuring a given orientation's
+// noise from the rests' scatter made the joint estimates inconsistent in 6 of 20 consumer runs,
+// so the assumption stays and the bound allows it.
 TEST(JointPipeline, TacticalGrade) {
   const Outcome o = monteCarlo("tactical", 20);
   EXPECT_EQ(o.solved, o.runs);
   EXPECT_LE(o.rms(), 0.06);
   EXPECT_EQ(o.identity_matrices, 0);  // their scale errors are always detected
-  expectHonestSigma(o);
+  expectHonestSigma(o, 0.95);
 }
 
 /// A noisy MEMS gyro on a vibrating mount (0.004 rad/s/sqrt(Hz), 20x the ideal grade's): the gyro
