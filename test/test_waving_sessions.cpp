@@ -136,45 +136,46 @@ void expectHonest(const Outcome& o) {
   EXPECT_GE(o.axes_within_3_sigma, o.axes - std::max(1, o.axes / 100));
 }
 
-// Measured 2026-11-26, seeds 1-20 (BENCHMARKS.md, "Recordings without rests"). Without rests the
-// accelerometer is not used and the rotation part of the gyro's misalignment (T_g's antisymmetric
-// part, held by the unit's prior) trades against R_cam_imu: each grade's 1-sigma is at least its
-// cross-axis prior / sqrt(2) per axis, and it covers the error.
+// Measured 2026-11-26, seeds 1-20 (BENCHMARKS.md, "Recordings without rests"), the camera
+// orientations with their positions (as camera_pose carries them): the accelerometer enters through
+// the acceleration model (links between motion nodes against the camera's velocities), which ties
+// R_cam_imu to gravity in the accelerometer's axes. Without positions the rotation part of the
+// gyro's misalignment trades against R_cam_imu (consumer 0.749 deg RMS, 1-sigma 0.40 per axis).
 
-// RMS 0.0063 deg (max 0.0101), 1-sigma norm RMS 0.0108, |z| <= 1.11, time offset error RMS
-// 0.015 ms (max 0.030). The ideal unit's T_g is exactly I, which the (consumer) prior is centred
-// on. Target <= 0.03 deg RMS: met.
+// RMS 0.0062 deg (max 0.0100), 1-sigma norm RMS 0.0108, |z| <= 1.11, time offset error RMS
+// 0.015 ms (max 0.030). Target <= 0.03 deg RMS: met.
 TEST(WavingSessions, IdealGrade) {
   const Outcome o = runWaving(sim::ImuGrade::kIdeal, seedCount());
   expectHonest(o);
   EXPECT_LT(o.rms(), 0.03);
 }
 
-// RMS 0.0649 deg (max 0.102), 1-sigma norm RMS 0.062 (0.036 per axis = 0.05 deg cross-axis prior
-// / sqrt(2)), |z| <= 2.30, time offset error RMS 0.010 ms (max 0.024). Target <= 0.03 deg RMS: NOT
-// met motion-only (the gauge above); asserted: honest, RMS within 0.09.
+// RMS 0.0547 deg (max 0.084), 1-sigma norm RMS 0.056, |z| <= 2.07, time offset error RMS 0.010 ms
+// (max 0.024); without positions 0.0649. Target <= 0.03 deg RMS: NOT met; asserted: honest, RMS
+// within 0.08.
 TEST(WavingSessions, TacticalGrade) {
   const Outcome o = runWaving(sim::ImuGrade::kTactical, seedCount());
   expectHonest(o);
-  EXPECT_LT(o.rms(), 0.09);
+  EXPECT_LT(o.rms(), 0.08);
 }
 
-// RMS 0.749 deg (max 1.20), 1-sigma norm RMS 0.699 (0.40 per axis: 1 % cross-axis / sqrt(2)),
-// |z| <= 2.50, time offset error RMS 0.018 ms (max 0.035). Target <= 0.05 deg RMS: NOT met
-// motion-only (expected: the gauge); asserted: honest, RMS within 1.0.
+// RMS 0.0908 deg (max 0.148), 1-sigma norm RMS 0.22 (conservative: |z| <= 0.79; the camera
+// positions are taken at 1 mm each, the simulator's are exact), time offset error RMS 0.019 ms
+// (max 0.035); without positions 0.749 deg. Target <= 0.05 deg RMS: NOT met; asserted: honest,
+// RMS within 0.15.
 TEST(WavingSessions, ConsumerGrade) {
   const Outcome o = runWaving(sim::ImuGrade::kConsumer, seedCount());
   expectHonest(o);
-  EXPECT_LT(o.rms(), 1.0);
+  EXPECT_LT(o.rms(), 0.15);
 }
 
-// RMS 1.50 deg (max 2.41), 1-sigma norm RMS 1.35, |z| <= 2.59, time offset error RMS 0.146 ms
-// (max 0.290); no estimate within the default broadcast gate (largest 1-sigma 0.5 deg).
+// RMS 0.293 deg (max 0.867), 1-sigma norm RMS 0.33, 59/60 axes within 3 sigma (max |z| 3.12), time
+// offset error RMS 0.145 ms (max 0.283); without positions 1.50 deg and no estimate within the
+// default broadcast gate.
 TEST(WavingSessions, NoisyGrade) {
   const Outcome o = runWaving(sim::ImuGrade::kNoisy, seedCount());
   expectHonest(o);
-  EXPECT_LT(o.rms(), 2.0);
-  EXPECT_EQ(o.gate_passed, 0);
+  EXPECT_LT(o.rms(), 0.5);
 }
 
 /// The one data path as calibrate_bag drives it (an OnlineCalibrator solving on the caller's

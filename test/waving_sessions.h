@@ -48,6 +48,7 @@ inline void feedOrientations(const simulation::SimulationRun& run, SampleSink* s
     CameraFrame frame;
     frame.stamp_s = o.stamp_s;
     frame.R_target_cam = o.R_target_cam;
+    frame.p_target_cam_m = o.p_target_cam;  // camera_pose's position (the acceleration model)
     sink->addFrame(frame);
   }
   feedUpTo(std::numeric_limits<double>::infinity());
