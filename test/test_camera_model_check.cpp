@@ -167,18 +167,14 @@ TEST(CameraModelCheck, FewerThanTwoViewsAreNotTested) {
 TEST(CameraModelCheck, VispRealImagesWithVispsIntrinsicsPass) {
   const std::string dir = test::vispDir();
   if (!std::ifstream(dir + "/franka_image-1.png")) GTEST_SKIP() << "no realdata at " << dir;
-  const TargetDescription board = test::vispBoard();
-  CameraIntrinsics intrinsics;
+  test::VispViews visp;
   std::string error;
-  ASSERT_TRUE(test::vispIntrinsics(&intrinsics, &error)) << error;
-  const TargetDetector detector(board);
+  ASSERT_TRUE(test::loadVispViews(&visp, &error)) << error;
+  const TargetDescription& board = visp.board;
+  CameraIntrinsics& intrinsics = visp.intrinsics;
   std::vector<CameraModelFit> views;
   for (int i = 1; i <= 8; ++i) {
-    const cv::Mat image =
-        cv::imread(dir + "/franka_image-" + std::to_string(i) + ".png", cv::IMREAD_GRAYSCALE);
-    ASSERT_FALSE(image.empty()) << i;
-    TargetObservation observation;
-    ASSERT_TRUE(detector.detect(image, &observation)) << "image " << i;
+    const TargetObservation& observation = visp.observations[i - 1];
     const auto start = std::chrono::steady_clock::now();
     const auto fit = fitCameraModel(observation, board, intrinsics);
     const double ms =

@@ -499,20 +499,14 @@ TEST(CameraPose, ReportedRotationCovarianceMatchesTheScatterUnderPixelNoise) {
 TEST(VispRealImages, AllChessboardsFoundAndRotationMatchesVisp) {
   const std::string dir = test::vispDir();
   if (!std::ifstream(dir + "/franka_image-1.png")) GTEST_SKIP() << "no realdata at " << dir;
-  const TargetDescription board = test::vispBoard();
-  CameraIntrinsics intrinsics;
+  test::VispViews visp;
   std::string error;
-  ASSERT_TRUE(test::vispIntrinsics(&intrinsics, &error)) << error;
-  const TargetDetector detector(board);
+  ASSERT_TRUE(test::loadVispViews(&visp, &error)) << error;
   std::vector<PoseOrientation> poses;
   for (int i = 1; i <= 8; ++i) {
-    const cv::Mat image =
-        cv::imread(dir + "/franka_image-" + std::to_string(i) + ".png", cv::IMREAD_GRAYSCALE);
-    ASSERT_FALSE(image.empty()) << i;
-    TargetObservation obs;
-    ASSERT_TRUE(detector.detect(image, &obs)) << "image " << i;
     std::string why;
-    const auto pose = estimateCameraPose(obs, board, intrinsics, PoseSettings(), &why);
+    const auto pose = estimateCameraPose(visp.observations[i - 1], visp.board, visp.intrinsics,
+                                         PoseSettings(), &why);
     ASSERT_TRUE(pose) << "image " << i << ": " << why;
     // Mean distance 0.24-0.48 px; the RMS reaches 0.55 px on image 4 (the Realsense's lens
     // distortion is not in ViSP's intrinsics, which declare none).

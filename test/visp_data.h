@@ -7,11 +7,14 @@
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/Core>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
+#include <vector>
 
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/vision/camera_model.h"
 #include "camera_imu_alignment/vision/target_description.h"
+#include "camera_imu_alignment/vision/target_detector.h"
 
 namespace camera_imu_alignment {
 namespace test {
@@ -46,6 +49,31 @@ inline bool readVispFlangeRotation(const std::string& path, Eigen::Matrix3d* R) 
   } catch (const YAML::Exception&) {
     return false;
   }
+}
+
+/// ViSP's board and intrinsics with the board found in each of the 8 images (franka_image-N.png).
+struct VispViews {
+  TargetDescription board = vispBoard();
+  CameraIntrinsics intrinsics;
+  std::vector<TargetObservation> observations;  ///< image N at N - 1
+};
+
+/// Loads the views; false (with `error`: the image or the setting) when an image is unreadable
+/// or its board is not found.
+inline bool loadVispViews(VispViews* views, std::string* error) {
+  if (!vispIntrinsics(&views->intrinsics, error)) return false;
+  const TargetDetector detector(views->board);
+  for (int i = 1; i <= 8; ++i) {
+    const std::string path = vispDir() + "/franka_image-" + std::to_string(i) + ".png";
+    const cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    TargetObservation observation;
+    if (image.empty() || !detector.detect(image, &observation)) {
+      *error = path + ": " + (image.empty() ? "unreadable" : "board not found");
+      return false;
+    }
+    views->observations.push_back(observation);
+  }
+  return true;
 }
 
 /// ViSP's published eMc rotation (p_flange = eMc p_cam) transposed: R_cam_imu with the flange as

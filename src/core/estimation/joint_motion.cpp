@@ -24,20 +24,7 @@ constexpr double kRestGuard = 0.05;
 /// camera's frames 0.1 s apart (in floating point, 0.0999999...) are all nodes, not every other.
 constexpr double kSpacingToleranceS = 1e-4;
 
-/// The samples of `gyro` within [from - margin, to + margin].
-void copySamples(const GyroStream& gyro, double from, double to, GyroSegment* segment) {
-  const auto first =
-      std::lower_bound(gyro.stamps_s.begin(), gyro.stamps_s.end(), from - kSampleMargin);
-  const auto last = std::upper_bound(first, gyro.stamps_s.end(), to + kSampleMargin);
-  const size_t a = static_cast<size_t>(first - gyro.stamps_s.begin());
-  const size_t b = static_cast<size_t>(last - gyro.stamps_s.begin());
-  segment->stamps_s.assign(gyro.stamps_s.begin() + a, gyro.stamps_s.begin() + b);
-  segment->gyro_rad_s.assign(gyro.gyro_rad_s.begin() + a, gyro.gyro_rad_s.begin() + b);
-  segment->noise_density_rad_s_sqrt_hz = gyro.noise_density_rad_s_sqrt_hz;
-  segment->interval = true;
-}
-
-/// The same for an accelerometer link: gyro and accelerometer samples.
+/// The samples of `gyro` (gyro and, when given, accelerometer) within [from - margin, to + margin].
 void copyStream(const GyroStream& gyro, double from, double to, GyroStream* out) {
   const auto first =
       std::lower_bound(gyro.stamps_s.begin(), gyro.stamps_s.end(), from - kSampleMargin);
@@ -46,9 +33,21 @@ void copyStream(const GyroStream& gyro, double from, double to, GyroStream* out)
   const size_t b = static_cast<size_t>(last - gyro.stamps_s.begin());
   out->stamps_s.assign(gyro.stamps_s.begin() + a, gyro.stamps_s.begin() + b);
   out->gyro_rad_s.assign(gyro.gyro_rad_s.begin() + a, gyro.gyro_rad_s.begin() + b);
-  out->accel_m_s2.assign(gyro.accel_m_s2.begin() + a, gyro.accel_m_s2.begin() + b);
+  if (gyro.accel_m_s2.size() == gyro.stamps_s.size()) {
+    out->accel_m_s2.assign(gyro.accel_m_s2.begin() + a, gyro.accel_m_s2.begin() + b);
+  }
   out->noise_density_rad_s_sqrt_hz = gyro.noise_density_rad_s_sqrt_hz;
   out->accel_noise_density_m_s2_sqrt_hz = gyro.accel_noise_density_m_s2_sqrt_hz;
+}
+
+/// The gyro samples of a segment around a motion node.
+void copySamples(const GyroStream& gyro, double from, double to, GyroSegment* segment) {
+  GyroStream samples;
+  copyStream(gyro, from, to, &samples);
+  segment->stamps_s = std::move(samples.stamps_s);
+  segment->gyro_rad_s = std::move(samples.gyro_rad_s);
+  segment->noise_density_rad_s_sqrt_hz = gyro.noise_density_rad_s_sqrt_hz;
+  segment->interval = true;
 }
 
 /// Central-difference velocity of the camera centre at frame k (target frame, m/s) and its
