@@ -10,6 +10,7 @@
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "motion_problem_simulation.h"
 #include "pipeline_simulation.h"
+#include "waving_sessions.h"
 
 namespace camera_imu_alignment {
 namespace {
@@ -90,6 +91,24 @@ TEST(MotionCalibrator, AnOffsetBeyondTheSearchRangeIsNamedWithTheRange) {
   EXPECT_FALSE(outcome.broadcast);
   EXPECT_NE(outcome.result.message.find("beyond the search range of +-0.100 s"), std::string::npos)
       << outcome.result.message;
+}
+
+// A 20 Hz camera's frames are 0.05 s apart only up to rounding (0.0499999... s): every one is kept
+// with the default motion_frame_interval_s of 0.05 (before: 788 of 1201, two of every three) and
+// every other one, 0.1 s apart, is a motion node (motion_node_spacing_s 0.1; before: 455 of 601).
+TEST(MotionCalibrator, KeepsEveryFrameOfACameraAtTheFrameInterval) {
+  const simulation::SimulationRun run(
+      test::wavingConfig(simulation::ImuGrade::kIdeal, 3, 0.015, 20.0));
+  ASSERT_EQ(run.camera_orientations.size(), 1201u);  // t = 0, 0.05, ..., 60
+  CalibrationPipeline pipeline(test::simulatedTarget(run.config), PipelineSettings{});
+  test::feedOrientations(run, &pipeline);
+  pipeline.finish();
+  const WindowSnapshot window = pipeline.snapshot();
+  EXPECT_GE(window.joint.motion_frames.size(), 1195u);
+  const AlignmentResult result = solveWindow(window, pipeline.settings());
+  ASSERT_TRUE(result.joint && result.joint->ok) << result.message;
+  EXPECT_GE(result.joint->motion_nodes, 590);
+  EXPECT_LE(result.joint->motion_nodes, 601);
 }
 
 }  // namespace

@@ -222,6 +222,9 @@ bool MessageInput::addCameraPose(const geometry_msgs::PoseStamped& msg, bool fee
   CameraFrame frame;
   frame.stamp_s = msg.header.stamp.toSec();
   frame.R_target_cam = *R_target_cam;
+  const auto& p = msg.pose.position;
+  const Eigen::Vector3d position(p.x, p.y, p.z);
+  if (position.allFinite()) frame.p_target_cam_m = position;
   pipeline_->addFrame(frame);
   return true;
 }

@@ -253,7 +253,8 @@ int run(const cia::CliArgs& args) {
             << snap.inputs.magnetic_samples << " magnetometer samples, "
             << (camera_poses ? info.camera_pose_messages : info.image_messages)
             << (camera_poses ? " camera poses; " : " images; ") << snap.rests.size()
-            << " stationary rests, " << snap.poses.size() << " poses\n";
+            << " stationary rests, " << snap.poses.size() << " poses, " << snap.inputs.motion_frames
+            << " camera orientations during motion\n";
   if (camera_poses && info.camera_pose_messages == 0) {
     std::cerr << "calibrate_bag: " << bag_path << ": no messages on " << topics.camera_pose
               << " (geometry_msgs/PoseStamped)"
@@ -329,9 +330,11 @@ int run(const cia::CliArgs& args) {
   if (status != cia::SolveStatus::kOk) {
     std::cerr << "calibrate_bag: " << report.result.message << "\n";
     if (snap.rests.empty()) {
-      std::cerr << "calibrate_bag: " << bag_path << ": the recording has no stationary rests (the "
-                << "rig never held still), and the estimate needs them: record again holding the "
-                   "rig still for a few seconds at each of several orientations\n";
+      std::cerr << "calibrate_bag: " << bag_path << ": the recording has no stationary rests and "
+                << snap.inputs.motion_frames
+                << " camera orientation(s) during motion: the estimate needs several seconds of "
+                   "motion about every axis with the target in view, or rests of a few seconds at "
+                   "several orientations\n";
     }
     const std::string target_problem = snap.target_diagnosis;
     if (!target_problem.empty()) {  // the target file, not the recording

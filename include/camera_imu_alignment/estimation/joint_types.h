@@ -55,13 +55,32 @@ struct MotionFrame {
   Eigen::Matrix3d R_target_cam = Eigen::Matrix3d::Identity();
   /// Covariance of R_target_cam (rad^2, camera axes, right perturbation), e.g. PnP's.
   Eigen::Matrix3d cov_cam_rad2 = Eigen::Matrix3d::Zero();
+  /// The camera's centre in the target frame (m), when known (PnP, camera_pose): the velocities
+  /// the acceleration model needs (JointSettings::motion_accel_link_s).
+  std::optional<Eigen::Vector3d> p_target_cam_m;
 };
 
-/// An unbroken stream of raw gyro samples (IMU clock, strictly increasing stamps, no gaps).
+/// An unbroken stream of raw gyro samples (IMU clock, strictly increasing stamps, no gaps), with
+/// the accelerometer's samples at the same stamps when given (empty: no acceleration model).
 struct GyroStream {
   std::vector<double> stamps_s;
   std::vector<Eigen::Vector3d> gyro_rad_s;  ///< raw, gyro axes
   double noise_density_rad_s_sqrt_hz = 0;   ///< measured white noise (rad/s/sqrt(Hz))
+  std::vector<Eigen::Vector3d>
+      accel_m_s2;  ///< raw, IMU (accelerometer) axes; empty or one per stamp
+  double accel_noise_density_m_s2_sqrt_hz = 0;  ///< measured white noise (m/s^2/sqrt(Hz))
+};
+
+/// The accelerometer during motion between two motion nodes (set by the estimator): gravity plus
+/// the rig's acceleration, against the change of the IMU's velocity the camera's positions give.
+struct AccelLink {
+  int from_pose = 0, to_pose = 0;  ///< motion nodes (JointProblem::poses), from < to
+  GyroStream samples;              ///< gyro and accelerometer over the interval and a margin
+  /// The velocities of the camera centre at the two nodes (target frame, m/s), from
+  /// the camera positions around them, and their 1-sigma per axis.
+  Eigen::Vector3d v_from_target_m_s = Eigen::Vector3d::Zero(),
+                  v_to_target_m_s = Eigen::Vector3d::Zero();
+  double velocity_sigma_m_s = 0;
 };
 
 /// Raw gyro samples from the end of rest `from_pose` to the start of rest `to_pose`. Sample i holds
@@ -101,6 +120,9 @@ struct JointProblem {
   /// motion_pairs.h) under a Gaussian prior of this 1-sigma (s). Unused without motion frames.
   double timeshift_initial_s = 0;
   double timeshift_prior_sigma_s = 0.05;
+  /// Set by the estimator from motion_frames with positions and motion_gyro's accelerometer
+  /// (callers leave it empty).
+  std::vector<AccelLink> accel_links;
 };
 
 /// 1-sigma of the Gaussian priors on the IMU parameters (mean: the ideal sensor, T = I, bias 0).
@@ -197,6 +219,15 @@ struct JointSettings {
   /// Motion nodes further than this (s) from the next node or rest are linked to it only when
   /// the gyro covers the gap: beyond it the chain breaks (the target was out of view).
   double motion_max_link_s = 2.0;
+  /// The acceleration model: the accelerometer between motion nodes about this far apart (s)
+  /// against the change of velocity from the camera's positions; 0: the accelerometer is used at
+  /// rests only. Longer links: the velocities' noise weighs less against gravity x duration.
+  double motion_accel_link_s = 1.0;
+  /// 1-sigma (m) of a camera position (PnP, camera_pose) for the velocities by central difference.
+  double camera_position_sigma_m = 1e-3;
+  /// 1-sigma (m) of the prior on each axis of the IMU's position in the camera frame (the lever
+  /// arm the acceleration model needs; estimated with it).
+  double lever_arm_prior_m = 0.2;
 };
 
 }  // namespace camera_imu_alignment

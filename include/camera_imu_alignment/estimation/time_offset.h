@@ -35,8 +35,11 @@ struct TimeshiftSearch {
 /// absolute values (robust to jerks) gives sigma, sigma / sqrt(rate) the density. 0 for fewer than
 /// 10 samples.
 double gyroNoiseDensityOf(const GyroStream& gyro);
+/// The same for any sampled 3-vector signal (the accelerometer: m/s^2/sqrt(Hz)).
+double whiteNoiseDensityOf(const std::vector<double>& stamps_s,
+                           const std::vector<Eigen::Vector3d>& values);
 
 TimeshiftSearch coarseTimeshift(const std::vector<MotionFrame>& frames, const GyroStream& gyro,
-                                double range_s, double max_interval_s = 0.2);
+                                double range_s, double max_interval_s = 0.35);
 
 }  // namespace camera_imu_alignment

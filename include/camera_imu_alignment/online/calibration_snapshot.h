@@ -95,6 +95,7 @@ enum class SnapshotContents { kState, kWithHistory };
 struct InputCounts {
   std::uint64_t imu_samples = 0, magnetic_samples = 0, frames = 0;
   std::uint64_t frames_detected = 0;  ///< frames at rest on which detection ran
+  std::uint64_t motion_frames = 0;    ///< frames during motion with a camera orientation
   std::uint64_t imu_gaps = 0;         ///< IMU stamp gaps that ended a rest
   bool has_intrinsics = false;
 };

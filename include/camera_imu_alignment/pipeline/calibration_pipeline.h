@@ -97,7 +97,7 @@ struct PipelineSettings {
   /// the raw gyro are kept this long (s) for the joint estimate's motion nodes; 0: rests only.
   double motion_window_s = 120.0;
   /// Frames during motion closer than this (s) to the last one used are skipped (detection cost).
-  double motion_frame_interval_s = 0.05;
+  double motion_frame_interval_s = 0.03;
   /// The camera-IMU time offset (timeshift_cam_imu) is searched within +- this (s).
   double max_timeshift_s = 0.1;
   double frame_queue_s = 3.0;  ///< frames older than the IMU by more are dropped (no IMU)

@@ -22,6 +22,9 @@ struct CameraFrame {
   /// the nodelet's camera_pose topic): then no image and no detection are needed. Use either
   /// images or given orientations in one pipeline, not both (they share the stamp order).
   std::optional<Eigen::Matrix3d> R_target_cam;
+  /// With R_target_cam: the camera's centre in the target frame (m), when given (camera_pose's
+  /// position); the joint estimate's acceleration model uses it during motion.
+  std::optional<Eigen::Vector3d> p_target_cam_m;
 };
 
 /// Where the IMU orientation of a pose comes from (calibration_pipeline.h).

@@ -170,9 +170,12 @@ JointResult solveModel(const JointProblem& problem, const Eigen::Matrix3d& R_cam
       state.timeshift_0 = state.timeshift[0];
     }
     ceres::Problem ceres_problem;
+    for (size_t k = 0; k < n; ++k) biases[k] = state.gyroBias(static_cast<int>(k));
+    const std::vector<joint::AccelLinkIntegral> accel_links =
+        joint::integrateAccelLinks(problem, state.gyroMatrix(), biases, state.timeshift[0]);
     const joint::BuiltProblem built =
-        joint::buildProblem(problem, gyro, rates_from, rates_to, whitening, observability, settings,
-                            &state, &ceres_problem);
+        joint::buildProblem(problem, gyro, rates_from, rates_to, accel_links, whitening,
+                            observability, settings, &state, &ceres_problem);
     ceres::Solver::Summary solver_summary;
     ceres::Solve(options, &ceres_problem, &solver_summary);
     result.iterations += static_cast<int>(solver_summary.iterations.size());

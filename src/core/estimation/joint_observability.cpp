@@ -90,8 +90,12 @@ JointObservability decideObservability(const JointProblem& problem, const GyroEx
   const bool rests = std::any_of(problem.poses.begin(), problem.poses.end(),
                                  [](const JointPose& pose) { return pose.at_rest; });
   out.accel_bias_estimated = rests;
-  out.accel_matrix_estimated = rests;
-  if (!rests) {
+  out.accel_matrix_estimated = rests || !problem.accel_links.empty();
+  if (!rests && !problem.accel_links.empty()) {
+    out.notes.push_back("no rests: the accelerometer is used through the acceleration model (" +
+                        std::to_string(problem.accel_links.size()) +
+                        " links between motion nodes against the camera's velocities)");
+  } else if (!rests) {
     out.notes.push_back(
         "no rests: the accelerometer is not used; R_cam_imu relative to its axes (the IMU frame) "
         "rests on the gyro misalignment prior (gyro_cross_axis): a few rests of 1-2 s tie them");

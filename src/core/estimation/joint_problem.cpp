@@ -59,7 +59,8 @@ class Builder {
 
   BuiltProblem build(const std::vector<GyroPreintegration>& gyro,
                      const std::vector<Eigen::Vector3d>& rates_from,
-                     const std::vector<Eigen::Vector3d>& rates_to) {
+                     const std::vector<Eigen::Vector3d>& rates_to,
+                     const std::vector<AccelLinkIntegral>& accel_links) {
     const size_t n = problem_.poses.size();
     for (size_t k = 0; k < n; ++k) {
       if (problem_.poses[k].at_rest) rests_.push_back(k);
@@ -78,12 +79,16 @@ class Builder {
     if (!observability_.magnetometer_used) {
       ceres_.SetManifold(state_.e_T.data(), new ceres::SubsetManifold(3, {2}));
     }
-    // Without rests nothing sees the world frame: R_world_target is a gauge.
-    if (rests_.empty() && !observability_.magnetometer_used) holdBlock(state_.e_T.data());
+    // Without rests or accelerometer links nothing sees the world frame: R_world_target is a
+    // gauge.
+    if (rests_.empty() && problem_.accel_links.empty() && !observability_.magnetometer_used) {
+      holdBlock(state_.e_T.data());
+    }
     for (size_t k = 0; k < n; ++k) addBlock(state_.delta[k].data(), 3);
     addAccelerometer();
     if (observability_.magnetometer_used) addMagnetometer();
     if (!problem_.segments.empty()) addGyro(gyro, rates_from, rates_to);
+    if (!problem_.accel_links.empty()) addAccelLinks(accel_links);
     return std::move(built_);
   }
 
@@ -144,7 +149,7 @@ class Builder {
              -1, 3);
     }
     const ImuModelPriors& p = settings_.priors;
-    if (rests_.empty()) {
+    if (rests_.empty() && problem_.accel_links.empty()) {
       holdBlock(state_.accel_matrix.data());  // no accelerometer data: nothing to estimate
       return;
     }
@@ -160,6 +165,7 @@ class Builder {
     } else {
       holdBlock(state_.accel_matrix.data());
     }
+    if (rests_.empty()) return;  // the accelerometer links have a bias of their own
     if (observability_.accel_bias_estimated || !pin_) {
       // The prior holds the first pose's bias, the walk each next one's.
       record(ceres_.AddResidualBlock(
@@ -314,6 +320,46 @@ class Builder {
            -1, -1, static_cast<int>(free_entries.size()));
   }
 
+  /// The accelerometer between motion nodes, with its bias during motion and the lever arm.
+  void addAccelLinks(const std::vector<AccelLinkIntegral>& integrals) {
+    const ImuModelPriors& p = settings_.priors;
+    addBlock(state_.motion_accel_bias.data(), 3);
+    record(ceres_.AddResidualBlock(
+               maskedPrior(3, {0, 1, 2}, std::vector<double>(3, p.accel_bias_m_s2)), nullptr,
+               state_.motion_accel_bias.data()),
+           -1, -1, 3);
+    addBlock(state_.lever_arm_m.data(), 3);
+    record(ceres_.AddResidualBlock(
+               maskedPrior(3, {0, 1, 2}, std::vector<double>(3, settings_.lever_arm_prior_m)),
+               nullptr, state_.lever_arm_m.data()),
+           -1, -1, 3);
+    for (size_t j = 0; j < problem_.accel_links.size(); ++j) {
+      const AccelLink& link = problem_.accel_links[j];
+      const AccelLinkIntegral& in = integrals[j];
+      const size_t from = static_cast<size_t>(link.from_pose),
+                   to = static_cast<size_t>(link.to_pose);
+      const Eigen::Matrix3d R_tc_from = projectToSO3(problem_.poses[from].R_target_cam);
+      const Eigen::Matrix3d R_tc_to = projectToSO3(problem_.poses[to].R_target_cam);
+      const Eigen::Matrix3d& X0 = cameraImu0(from);
+      const double density = link.samples.accel_noise_density_m_s2_sqrt_hz;
+      const double variance = density * density * in.duration_s +
+                              2.0 * link.velocity_sigma_m_s * link.velocity_sigma_m_s;
+      auto* cost = new ceres::AutoDiffCostFunction<AccelLinkResidual, 3, 3, 3, 3, 6, 3, 3, 9, 3, 3>(
+          new AccelLinkResidual{
+              targetCam(from), X0, state_.R_world_target_0, in.dv0, in.bias_jacobian, in.per_entry,
+              link.v_to_target_m_s - link.v_from_target_m_s, R_tc_from * skew(X0 * in.rate_from),
+              R_tc_to * skew(X0 * in.rate_to), settings_.gravity_m_s2, in.duration_s,
+              1.0 / std::sqrt(variance), settings_.accel_matrix_form, in.gyro_jacobian,
+              in.theta0_minus_identity});
+      const std::vector<double*> blocks = {
+          state_.e_T.data(),          cameraImuIncrement(from),        state_.delta[from].data(),
+          state_.accel_matrix.data(), state_.motion_accel_bias.data(), state_.lever_arm_m.data(),
+          state_.gyro_matrix.data(),  state_.gyro_bias[from].data(),   state_.gyro_bias[to].data()};
+      record(ceres_.AddResidualBlock(cost, loss_, blocks), static_cast<int>(from),
+             static_cast<int>(to), 3);
+    }
+  }
+
   /// The time offset's block and its prior, once (motion nodes).
   void addTimeshift() {
     if (timeshift_added_) return;
@@ -345,11 +391,13 @@ class Builder {
 
 BuiltProblem buildProblem(const JointProblem& problem, const std::vector<GyroPreintegration>& gyro,
                           const std::vector<Eigen::Vector3d>& rates_from,
-                          const std::vector<Eigen::Vector3d>& rates_to, const Whitening& whitening,
-                          const JointObservability& observability, const JointSettings& settings,
-                          State* state, ceres::Problem* ceres_problem) {
+                          const std::vector<Eigen::Vector3d>& rates_to,
+                          const std::vector<AccelLinkIntegral>& accel_links,
+                          const Whitening& whitening, const JointObservability& observability,
+                          const JointSettings& settings, State* state,
+                          ceres::Problem* ceres_problem) {
   return Builder(problem, whitening, observability, settings, state, ceres_problem)
-      .build(gyro, rates_from, rates_to);
+      .build(gyro, rates_from, rates_to, accel_links);
 }
 
 }  // namespace joint

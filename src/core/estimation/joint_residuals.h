@@ -240,6 +240,64 @@ struct MotionGyroResidual {
   }
 };
 
+/// R_world_imu v for R_world_imu = Exp(e_T) T0 R_target_cam Exp(delta) Exp(e_X) X0 (the inverse
+/// chain of imuFromWorld).
+template <typename T>
+Vector3<T> worldFromImu(const Eigen::Matrix3d& T0_target_cam, const Eigen::Matrix3d& X0,
+                        const T* e_T, const T* delta, const T* e_X, const Vector3<T>& v_imu) {
+  Vector3<T> a = X0.cast<T>() * v_imu, b;
+  ceres::AngleAxisRotatePoint(e_X, a.data(), b.data());
+  ceres::AngleAxisRotatePoint(delta, b.data(), a.data());
+  b = T0_target_cam.cast<T>() * a;
+  ceres::AngleAxisRotatePoint(e_T, b.data(), a.data());
+  return a;
+}
+
+/// The accelerometer between two motion nodes (AccelLink, joint_motion.h): the IMU's change of
+/// velocity in W from the accelerometer, R_world_imu_from int DeltaR T_a^-1 (a - b) dt + g_world T,
+/// against the one the camera's positions give, R_world_target (v_imu_to - v_imu_from) with
+/// v_imu = v_cam + R_target_cam (w_cam x l), l the IMU's position in the camera frame (m).
+struct AccelLinkResidual {
+  Eigen::Matrix3d T0_target_cam_from, X0, T0;  // T0 R_target_cam_from, X0, T0 = R_world_target_0
+  Eigen::Vector3d dv0;
+  Eigen::Matrix3d bias_jacobian;
+  Eigen::Matrix<double, 3, 9> per_entry;
+  Eigen::Vector3d v_cam_difference_target;  // v_cam_to - v_cam_from (target frame, m/s)
+  Eigen::Matrix3d lever_from, lever_to;     // R_target_cam_k [w_cam_k]x: velocity = lever_k l
+  double gravity_m_s2, duration_s, inverse_sigma;
+  AccelMatrixForm form;
+  Eigen::Matrix<double, 3, 15> gyro_jacobian;  // d dv0 / d theta (T_g, bias from, bias to)
+  Eigen::Matrix<double, 15, 1> theta0_minus_identity;
+
+  template <typename T>
+  bool operator()(const T* e_T, const T* e_X, const T* delta, const T* accel_matrix,
+                  const T* accel_bias, const T* lever, const T* gyro_matrix, const T* gyro_from,
+                  const T* gyro_to, T* residual) const {
+    const Matrix3<T> P = accelMatrix(accel_matrix, form) - Matrix3<T>::Identity();
+    const Eigen::Map<const Vector3<T>> b(accel_bias);
+    Eigen::Matrix<T, 15, 1> dtheta;
+    for (int i = 0; i < 9; ++i) dtheta(i) = gyro_matrix[i] - T(theta0_minus_identity(i));
+    for (int i = 0; i < 3; ++i) {
+      dtheta(9 + i) = gyro_from[i] - T(theta0_minus_identity(9 + i));
+      dtheta(12 + i) = gyro_to[i] - T(theta0_minus_identity(12 + i));
+    }
+    Vector3<T> f = dv0.cast<T>() + gyro_jacobian.cast<T>() * dtheta - bias_jacobian.cast<T>() * b;
+    for (int s = 0; s < 3; ++s) {
+      for (int u = 0; u < 3; ++u) f -= P(s, u) * per_entry.col(3 * s + u).cast<T>();
+    }
+    Vector3<T> predicted = worldFromImu(T0_target_cam_from, X0, e_T, delta, e_X, f);
+    predicted(2) -= T(gravity_m_s2 * duration_s);
+    const Eigen::Map<const Vector3<T>> l(lever);
+    const Vector3<T> v_target =
+        v_cam_difference_target.cast<T>() + lever_to.cast<T>() * l - lever_from.cast<T>() * l;
+    const Vector3<T> v_rotated = T0.cast<T>() * v_target;
+    Vector3<T> measured;
+    ceres::AngleAxisRotatePoint(e_T, v_rotated.data(), measured.data());
+    for (int i = 0; i < 3; ++i) residual[i] = T(inverse_sigma) * (predicted(i) - measured(i));
+    return true;
+  }
+};
+
 /// Bias random walk (gyro or accelerometer) between consecutive rests: r = (b_to - b_from) / sigma.
 struct BiasWalkResidual {
   double inverse_sigma;  // 1 / (walk * sqrt(dt)), in the bias' inverse units

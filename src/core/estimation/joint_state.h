@@ -13,6 +13,7 @@
 #include "camera_imu_alignment/estimation/gyro_preintegration.h"
 #include "camera_imu_alignment/estimation/joint_observability.h"
 #include "camera_imu_alignment/estimation/joint_types.h"
+#include "joint_motion.h"
 
 namespace camera_imu_alignment {
 namespace joint {
@@ -39,6 +40,9 @@ struct State {
   /// timeshift_cam_imu (s) and the value the gyro was last preintegrated at (motion nodes).
   std::array<double, 1> timeshift{};
   double timeshift_0 = 0;
+  /// The acceleration model (JointProblem::accel_links): the accelerometer bias during motion
+  /// (m/s^2) and the IMU's position in the camera frame (m).
+  std::array<double, 3> motion_accel_bias{}, lever_arm_m{};
 
   Eigen::Matrix3d gyroMatrix() const;  ///< T_g
   Eigen::Vector3d gyroBias(int pose) const;
@@ -89,6 +93,12 @@ inline double linkTime(const JointPose& pose) {
   return pose.at_rest ? 0.5 * (pose.start_s + pose.end_s) : pose.start_s;
 }
 
+/// The accelerometer links preintegrated at T_g, the per-pose biases and the time offset.
+std::vector<AccelLinkIntegral> integrateAccelLinks(const JointProblem& problem,
+                                                   const Eigen::Matrix3d& T_g,
+                                                   const std::vector<Eigen::Vector3d>& biases,
+                                                   double timeshift);
+
 /// True when a segment has a motion node at an end (then the time offset is estimated).
 bool hasMotionSegments(const JointProblem& problem);
 
@@ -114,9 +124,11 @@ State initialState(const JointProblem& problem, const Eigen::Matrix3d& R_cam_imu
 /// holds what `observability` does not estimate.
 BuiltProblem buildProblem(const JointProblem& problem, const std::vector<GyroPreintegration>& gyro,
                           const std::vector<Eigen::Vector3d>& rates_from,
-                          const std::vector<Eigen::Vector3d>& rates_to, const Whitening& whitening,
-                          const JointObservability& observability, const JointSettings& settings,
-                          State* state, ceres::Problem* ceres_problem);
+                          const std::vector<Eigen::Vector3d>& rates_to,
+                          const std::vector<AccelLinkIntegral>& accel_links,
+                          const Whitening& whitening, const JointObservability& observability,
+                          const JointSettings& settings, State* state,
+                          ceres::Problem* ceres_problem);
 
 /// Covariances, chi2, per-pose norms, intrinsics and the parameter list into `result` (R_cam_imu
 /// and notes are set by the caller). False (with result->message) when the covariance fails.

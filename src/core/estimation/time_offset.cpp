@@ -48,14 +48,18 @@ class GyroIntegral {
 }  // namespace
 
 double gyroNoiseDensityOf(const GyroStream& gyro) {
-  const size_t n = std::min(gyro.stamps_s.size(), gyro.gyro_rad_s.size());
+  return whiteNoiseDensityOf(gyro.stamps_s, gyro.gyro_rad_s);
+}
+
+double whiteNoiseDensityOf(const std::vector<double>& stamps_s,
+                           const std::vector<Eigen::Vector3d>& values) {
+  const size_t n = std::min(stamps_s.size(), values.size());
   if (n < 10) return 0.0;
   std::vector<double> absolute, intervals;
   for (size_t i = 1; i + 1 < n; ++i) {
-    const Eigen::Vector3d second =
-        gyro.gyro_rad_s[i + 1] - 2.0 * gyro.gyro_rad_s[i] + gyro.gyro_rad_s[i - 1];
+    const Eigen::Vector3d second = values[i + 1] - 2.0 * values[i] + values[i - 1];
     for (int a = 0; a < 3; ++a) absolute.push_back(std::abs(second(a)));
-    intervals.push_back(gyro.stamps_s[i + 1] - gyro.stamps_s[i]);
+    intervals.push_back(stamps_s[i + 1] - stamps_s[i]);
   }
   const auto median = [](std::vector<double>* v) {
     std::nth_element(v->begin(), v->begin() + v->size() / 2, v->end());

@@ -462,6 +462,7 @@ InputCounts OnlineCalibrator::inputCounts() const {
   counts.magnetic_samples = p.magneticSamples();
   counts.frames = p.frames();
   counts.frames_detected = p.framesDetected();
+  counts.motion_frames = p.motionFrames();
   counts.imu_gaps = p.imuGaps();
   counts.has_intrinsics = p.hasIntrinsics();
   return counts;

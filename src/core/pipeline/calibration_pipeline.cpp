@@ -152,9 +152,9 @@ void CalibrationPipeline::addImu(const ImuSample& sample) {
   s.processFrames(false);
   s.imu_buffer.push_back(sample);
   if (s.settings.motion_window_s > 0.0) {
-    s.motion_gyro.emplace_back(sample.stamp_s, sample.gyro_rad_s);
+    s.motion_gyro.push_back({sample.stamp_s, sample.gyro_rad_s, sample.accel_m_s2});
     const double keep_s = s.settings.motion_window_s + s.settings.max_timeshift_s + 1.0;
-    while (s.motion_gyro.front().first < sample.stamp_s - keep_s) s.motion_gyro.pop_front();
+    while (s.motion_gyro.front().stamp_s < sample.stamp_s - keep_s) s.motion_gyro.pop_front();
   }
   while (!s.imu_buffer.empty() &&
          s.imu_buffer.front().stamp_s < sample.stamp_s - s.settings.max_gyro_span_s) {
@@ -315,11 +315,15 @@ void CalibrationPipeline::Impl::processFrame(const CameraFrame& frame) {
 }
 
 void CalibrationPipeline::Impl::processMotionFrame(const CameraFrame& frame) {
-  if (frame.stamp_s - last_motion_frame_stamp < settings.motion_frame_interval_s) return;
+  if (frame.stamp_s - last_motion_frame_stamp <
+      settings.motion_frame_interval_s - kMotionIntervalToleranceS) {
+    return;
+  }
   MotionFrame motion;
   motion.stamp_s = frame.stamp_s;
   if (frame.R_target_cam) {
     motion.R_target_cam = *frame.R_target_cam;
+    motion.p_target_cam_m = frame.p_target_cam_m;
     // A given orientation states no covariance: a motion-capture or PnP class 1-sigma; the joint
     // estimate scales its covariance by chi2/dof when the data say it is larger.
     const double sigma_rad = kGivenOrientationSigmaDeg * 3.14159265358979323846 / 180.0;
@@ -338,6 +342,7 @@ void CalibrationPipeline::Impl::processMotionFrame(const CameraFrame& frame) {
     const auto pose = estimateCameraPose(observation, target, *intrinsics, settings.pose, &why);
     if (!pose) return;  // a poor fit (e.g. motion blur): dropped by the PnP checks
     motion.R_target_cam = pose->R_target_cam;
+    motion.p_target_cam_m = pose->p_target_cam;
     motion.cov_cam_rad2 = pose->cov_rotation_rad2;
   }
   last_motion_frame_stamp = frame.stamp_s;

@@ -17,6 +17,10 @@ namespace camera_imu_alignment {
 
 /// 1-sigma (deg per axis) assumed for a camera orientation given without covariance (camera_pose).
 constexpr double kGivenOrientationSigmaDeg = 0.05;
+/// Frames during motion differing by less than this (s) from motion_frame_interval_s count as
+/// that far apart: a 20 Hz camera's frames (0.05 s apart, in floating point 0.0499999...) are all
+/// kept with the default 0.05 s, not two of every three.
+constexpr double kMotionIntervalToleranceS = 1e-4;
 
 /// Camera pose of one frame taken at rest.
 struct FrameDetection {
@@ -92,7 +96,12 @@ struct CalibrationPipeline::Impl {
 
   // --- continuous motion (settings.motion_window_s > 0)
   std::deque<MotionFrame> motion_frames;  ///< frames outside the rests with a camera orientation
-  std::deque<std::pair<double, Eigen::Vector3d>> motion_gyro;  ///< raw gyro (stamp, rad/s)
+  /// Raw IMU samples during the motion window: stamp, gyro (rad/s), accelerometer (m/s^2).
+  struct RawImu {
+    double stamp_s;
+    Eigen::Vector3d gyro_rad_s, accel_m_s2;
+  };
+  std::deque<RawImu> motion_gyro;
   double last_motion_frame_stamp = -std::numeric_limits<double>::infinity();
   std::uint64_t motion_frames_total = 0;
   std::uint64_t motion_detections = 0;  ///< frames during motion on which detection ran

@@ -27,12 +27,15 @@ void CalibrationPipeline::Impl::addMotion(double from_s, JointProblem* problem) 
   const double gyro_from =
       std::min(from_s, problem->motion_frames.front().stamp_s) - settings.max_timeshift_s - 0.5;
   GyroStream& gyro = problem->motion_gyro;
-  for (const auto& [stamp, rate] : motion_gyro) {
-    if (stamp < gyro_from) continue;
-    gyro.stamps_s.push_back(stamp);
-    gyro.gyro_rad_s.push_back(rate);
+  for (const RawImu& sample : motion_gyro) {
+    if (sample.stamp_s < gyro_from) continue;
+    gyro.stamps_s.push_back(sample.stamp_s);
+    gyro.gyro_rad_s.push_back(sample.gyro_rad_s);
+    gyro.accel_m_s2.push_back(sample.accel_m_s2);
   }
   gyro.noise_density_rad_s_sqrt_hz = last_gyro_noise_density;
+  // The accelerometer's white noise during the motion itself (vibration included).
+  gyro.accel_noise_density_m_s2_sqrt_hz = whiteNoiseDensityOf(gyro.stamps_s, gyro.accel_m_s2);
 }
 
 std::string prepareMotion(const PipelineSettings& settings, WindowSnapshot* window) {
