@@ -138,5 +138,40 @@ TEST(JointMotion, AConsumerGyrosErrorsAreCoveredByTheReportedSigma) {
   }
 }
 
+TEST(JointMotion, AnUnderstatedCameraCovarianceIsScaledUntilTheResidualsFitIt) {
+  // The camera's noise 0.2 deg per axis, stated as 0.02 deg (a camera_pose message states none;
+  // motion capture's noise during motion is many times its noise at rest: test_broad_motion). The
+  // estimator scales the motion frames' covariance by chi2/dof (about 100 here): the answer and its
+  // 1-sigma are those of the correctly stated covariance, not that 1-sigma scaled by 10.
+  test::MotionSimulationOptions o;  // consumer gyro: T_g's rotation trades off with R_cam_imu
+  o.camera_sigma_rad = 3.5e-3;
+  for (uint64_t seed : {7, 8}) {
+    test::MotionSimulation sim = test::simulateMotionProblem(o, seed);
+    const TimeshiftSearch coarse =
+        coarseTimeshift(sim.problem.motion_frames, sim.problem.motion_gyro, 0.2);
+    ASSERT_TRUE(coarse.ok) << coarse.message;
+    sim.problem.timeshift_initial_s = coarse.timeshift_cam_imu_s;
+    sim.problem.timeshift_prior_sigma_s = 0.01;
+    const Eigen::Matrix3d initial = test::perturbedRotation(sim.R_cam_imu, 5.0 * kDeg, seed);
+    const JointResult stated_right = JointEstimator().solve(sim.problem, initial);
+    for (MotionFrame& frame : sim.problem.motion_frames) frame.cov_cam_rad2 *= 0.01;
+    const JointResult understated = JointEstimator().solve(sim.problem, initial);
+    ASSERT_TRUE(stated_right.ok && understated.ok) << understated.message;
+    EXPECT_EQ(stated_right.motion_covariance_scale, 1.0);
+    EXPECT_GT(understated.motion_covariance_scale, 70.0) << "seed " << seed;
+    EXPECT_LT(understated.motion_covariance_scale, 140.0) << "seed " << seed;
+    EXPECT_LT(understated.chi2 / understated.dof, 1.5);
+    const Eigen::Vector3d error = test::rotationError(understated.R_cam_imu, sim.R_cam_imu);
+    EXPECT_LT(error.dot(understated.covariance_rad2.ldlt().solve(error)), 14.2) << "seed " << seed;
+    EXPECT_LT(understated.std_dev_deg.norm(), 1.3 * stated_right.std_dev_deg.norm());
+    EXPECT_NEAR(understated.timeshift_cam_imu_s, sim.timeshift_cam_imu_s,
+                3.0 * understated.timeshift_sigma_s + 1e-4);
+    std::printf("seed %llu: scale %.1f, error %.3f deg, 1-sigma %.3f (stated right %.3f) deg\n",
+                static_cast<unsigned long long>(seed), understated.motion_covariance_scale,
+                error.norm() / kDeg, understated.std_dev_deg.norm(),
+                stated_right.std_dev_deg.norm());
+  }
+}
+
 }  // namespace
 }  // namespace camera_imu_alignment

@@ -69,6 +69,10 @@ struct JointResult {
   Eigen::Matrix3d covariance_rad2 = Eigen::Matrix3d::Zero();
   Eigen::Vector3d std_dev_deg = Eigen::Vector3d::Zero();  ///< camera x, y, z axes
   double covariance_scale = 1.0;  ///< chi2 / dof applied to every covariance (1 when <= 1)
+  /// Factor the motion frames' camera covariance (MotionFrame::cov_cam_rad2) was scaled by before
+  /// the final solve, when the residuals said it was understated (chi2/dof > 2; then until < 1.1):
+  /// 1 when not. Understated, the motion would outweigh the IMU's priors (JointEstimator::solve).
+  double motion_covariance_scale = 1.0;
   /// With JointProblem::mount_change_pose: R_cam_imu of the poses from that index on (R_cam_imu
   /// is then the earlier poses').
   std::optional<Eigen::Matrix3d> R_cam_imu_after_change;

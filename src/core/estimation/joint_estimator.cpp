@@ -456,8 +456,38 @@ JointResult JointEstimator::solve(const JointProblem& problem,
     refused.message = motion_error;
     return refused;
   }
-  const joint::ExpandedProblem expanded = joint::expandMotion(problem, settings_);
+  joint::ExpandedProblem expanded = joint::expandMotion(problem, settings_);
   JointResult chosen = screenMagnetometer(expanded.problem, R_cam_imu_initial, settings_);
+  // A motion frame's covariance is often a guess (camera_pose states none; blur and jitter grow
+  // with the speed). Understated, the motion outweighs the IMU's priors and T_g's rotation, which
+  // trades off with R_cam_imu without rests, absorbs the misfit (BENCHMARKS.md, BROAD): scaled.
+  // Not for the fits alone (compute_covariance false: the mount-change test compares chi2 values
+  // on the weights its one-mount estimate settled on, JointResult::motion_covariance_scale).
+  double motion_scale = 1.0;
+  for (int round = 0; round < joint::kMaxMotionReweights && chosen.ok &&
+                      expanded.motion_nodes > 0 && settings_.compute_covariance;
+       ++round) {
+    const double misfit = chosen.dof > 0 ? chosen.chi2 / chosen.dof : 0.0;
+    if (!(misfit > (round == 0 ? joint::kMotionReweightAbove : joint::kMotionReweightSettled))) {
+      break;
+    }
+    for (JointPose& pose : expanded.problem.poses) {
+      if (!pose.at_rest) pose.cov_cam_rad2 *= misfit;
+    }
+    JointResult again = screenMagnetometer(expanded.problem, R_cam_imu_initial, settings_);
+    if (!again.ok) break;  // the last usable estimate stands
+    motion_scale *= misfit;
+    chosen = std::move(again);
+  }
+  if (chosen.ok && motion_scale > 1.0) {
+    char buffer[160];
+    std::snprintf(buffer, sizeof(buffer),
+                  "the motion frames' camera covariance scaled by %.1f (1-sigma x %.2f): their "
+                  "residuals exceeded it",
+                  motion_scale, std::sqrt(motion_scale));
+    chosen.notes.push_back(buffer);
+    chosen.motion_covariance_scale = motion_scale;
+  }
   joint::mapResultToCaller(expanded, &chosen);
   chosen.solve_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
