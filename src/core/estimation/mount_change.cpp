@@ -74,6 +74,17 @@ JointProblem withFieldsOf(const JointProblem& problem, const JointResult& one_mo
 MountChangeTest testMountChange(const JointProblem& problem, const JointResult& one_mount,
                                 const JointSettings& joint_settings,
                                 const MountChangeSettings& settings) {
+  if (!problem.motion_frames.empty()) {
+    // The change is tested on the rests alone: the motion during which the mount moved holds
+    // nodes of both mounts that no split at a rest can assign, and their misfit would blur the
+    // chi-square drop (a noisy unit's 2 deg remount went unseen). The one-mount fit is redone on
+    // the same rests, so the two are compared on the same data.
+    JointProblem rests = problem;
+    rests.motion_frames.clear();
+    rests.motion_gyro = GyroStream{};
+    const JointResult rests_one = JointEstimator(joint_settings).solve(rests, one_mount.R_cam_imu);
+    return testMountChange(rests, rests_one, joint_settings, settings);
+  }
   MountChangeTest test;
   const int n = static_cast<int>(problem.poses.size());
   const int first = std::max(settings.min_poses_before, n - settings.max_poses_after);
