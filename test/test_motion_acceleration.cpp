@@ -81,8 +81,8 @@ TEST(MotionAcceleration, ExactDataGiveTheTruth) {
 namespace camera_imu_alignment {
 namespace {
 
-// Measured (seeds 3-5, 60 s at 20 Hz, 15 ms offset): 0.069, 0.025, 0.080 deg with 1-sigma norms
-// 0.22, 0.20, 0.22 (the camera positions are taken at 1 mm each: conservative for the simulator's
+// Measured (seeds 3-5, 60 s at 20 Hz, 15 ms offset): 0.057, 0.016, 0.081 deg with 1-sigma norms
+// 0.21, 0.20, 0.23 (the camera positions are taken at 1 mm each: conservative for the simulator's
 // exact ones); the offset to 0.02 ms. Motion alone without the acceleration model: ~0.4 deg per
 // axis of 1-sigma.
 TEST(MotionAcceleration, ConsumerGradeWithItsErrors) {

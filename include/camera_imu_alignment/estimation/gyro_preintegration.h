@@ -44,6 +44,11 @@ GyroPreintegration preintegrateGyro(const std::vector<double>& stamps_s,
                                     double t_to_s, const Eigen::Matrix3d& T_g,
                                     const Eigen::Vector3d& b_from, const Eigen::Vector3d& b_to);
 
+/// The sampled signal at time t, linear between the first n samples (each the value at its stamp;
+/// the first or last sample outside them). Stamps increasing, n >= 1.
+Eigen::Vector3d interpolateSamples(const std::vector<double>& stamps_s,
+                                   const std::vector<Eigen::Vector3d>& values, size_t n, double t);
+
 /// The same over exactly [t_from_s, t_to_s] of an unbroken stream (continuous motion, where the
 /// interval's ends fall between samples): each sample is the rate at its stamp, the rate between
 /// two samples is interpolated linearly (a zero-order hold would shift the rotation by half a

@@ -119,6 +119,16 @@ GyroPreintegration preintegrateGyro(const std::vector<double>& stamps_s,
   return acc.result(gyroModelVector(T_g, b_from, b_to));
 }
 
+Eigen::Vector3d interpolateSamples(const std::vector<double>& stamps_s,
+                                   const std::vector<Eigen::Vector3d>& values, size_t n, double t) {
+  const size_t i = static_cast<size_t>(std::upper_bound(stamps_s.begin(), stamps_s.begin() + n, t) -
+                                       stamps_s.begin());
+  if (i == 0) return values[0];
+  if (i >= n) return values[n - 1];
+  const double w = (t - stamps_s[i - 1]) / (stamps_s[i] - stamps_s[i - 1]);
+  return (1.0 - w) * values[i - 1] + w * values[i];
+}
+
 GyroPreintegration preintegrateGyroInterval(
     const std::vector<double>& stamps_s, const std::vector<Eigen::Vector3d>& gyro_rad_s,
     double t_from_s, double t_to_s, const Eigen::Matrix3d& T_g, const Eigen::Vector3d& b_from,
@@ -128,14 +138,7 @@ GyroPreintegration preintegrateGyroInterval(
   const size_t n = std::min(stamps_s.size(), gyro_rad_s.size());
   const double ramp_s = t_to_s - t_from_s;
   if (n < 2 || !(ramp_s > 0.0)) return acc.result(theta0);
-  const auto rawAt = [&](double t) -> Eigen::Vector3d {
-    size_t i = static_cast<size_t>(std::upper_bound(stamps_s.begin(), stamps_s.begin() + n, t) -
-                                   stamps_s.begin());
-    if (i == 0) return gyro_rad_s[0];
-    if (i >= n) return gyro_rad_s[n - 1];
-    const double w = (t - stamps_s[i - 1]) / (stamps_s[i] - stamps_s[i - 1]);
-    return (1.0 - w) * gyro_rad_s[i - 1] + w * gyro_rad_s[i];
-  };
+  const auto rawAt = [&](double t) { return interpolateSamples(stamps_s, gyro_rad_s, n, t); };
   // Sub-intervals between the interval's ends and the samples inside it; each is integrated at
   // its midpoint's interpolated rate (exact for a rate linear between samples).
   double t = t_from_s;

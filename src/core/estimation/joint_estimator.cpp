@@ -170,7 +170,7 @@ JointResult solveModel(const JointProblem& problem, const Eigen::Matrix3d& R_cam
       state.timeshift_0 = state.timeshift[0];
     }
     ceres::Problem ceres_problem;
-    for (size_t k = 0; k < n; ++k) biases[k] = state.gyroBias(static_cast<int>(k));
+    // biases holds the state's (set above, or before the first pass).
     const std::vector<joint::AccelLinkIntegral> accel_links =
         joint::integrateAccelLinks(problem, state.gyroMatrix(), biases, state.timeshift[0]);
     const joint::BuiltProblem built =
