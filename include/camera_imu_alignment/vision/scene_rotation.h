@@ -1,0 +1,80 @@
+// The camera's rotation between two views of a natural scene (no calibration target): features
+// at each view (SIFT: sub-pixel, scale-invariant), robust matching, and the relative rotation with
+// its covariance, for any baseline: a rotation about the camera centre or a distant scene (the
+// homography at infinity, rotation only) as well as a rig moved metres between the views (the
+// essential matrix), the model chosen by the data (GRIC), refined with a translation-free cost.
+//
+// Frames: camera optical frames (z forward, x right, y down). R_from_to maps vectors in the `to`
+// view's camera frame into the `from` view's: with a world-fixed frame G,
+// R_G_cam_to = R_G_cam_from R_from_to. Bearings are unit vectors in the camera frame
+// (undistorted through camera_info's model). Covariances are in rad^2, `to` camera axes, right
+// perturbation R_from_to Exp(delta).
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "camera_imu_alignment/vision/camera_model.h"
+
+namespace camera_imu_alignment {
+
+struct SceneFeatureSettings {
+  int max_features = 1500;  ///< strongest SIFT keypoints kept per view
+};
+
+/// The features of one view (a rest's sharpest frame).
+struct SceneFeatures {
+  double stamp_s = 0;                     ///< the frame's stamp (camera clock, s)
+  std::vector<cv::KeyPoint> keypoints;    ///< pixels (distorted image)
+  cv::Mat descriptors;                    ///< one row per keypoint (CV_32F, SIFT)
+  std::vector<Eigen::Vector3d> bearings;  ///< unit vectors, camera frame, one per keypoint
+};
+
+/// Sharpness of a mono8 image (variance of its Laplacian; larger is sharper): picks a rest's
+/// frame least blurred by residual motion.
+double imageSharpness(const cv::Mat& mono8);
+
+/// SIFT keypoints and descriptors of a mono8 image with their undistorted bearings. An unusable
+/// image (empty, not mono8, intrinsics of another size) gives no features.
+SceneFeatures extractSceneFeatures(const cv::Mat& mono8, const CameraIntrinsics& intrinsics,
+                                   const SceneFeatureSettings& settings, double stamp_s);
+
+enum class SceneMotionModel {
+  kRotationOnly,  ///< rotation about the camera centre or a distant scene (homography at infinity)
+  kGeneral        ///< rotation and translation (essential matrix)
+};
+
+struct SceneRotationSettings {
+  double ratio_test = 0.8;  ///< Lowe's ratio of the best to the second-best descriptor distance
+  /// Fewer inliers than this: no rotation (too little overlap, texture or a scene that moved).
+  int min_inliers = 40;
+  /// A gyro-predicted rotation further than this (deg) from the estimate fails the pair
+  /// (a repetitive texture's wrong but consistent matches); 0: not checked.
+  double max_prediction_difference_deg = 5.0;
+};
+
+/// The camera's rotation between two views, with what the fit says about it.
+struct SceneRotation {
+  bool ok = false;
+  std::string message;  ///< why not, with the counts (matches, inliers)
+  Eigen::Matrix3d R_from_to = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d cov_rad2 = Eigen::Matrix3d::Zero();  ///< `to` camera axes, right perturbation
+  SceneMotionModel model = SceneMotionModel::kRotationOnly;
+  /// kGeneral: the unit direction of the `to` camera centre in the `from` camera frame.
+  Eigen::Vector3d translation_direction = Eigen::Vector3d::Zero();
+  int matches = 0;             ///< after the ratio test and the mutual check
+  int inliers = 0;             ///< of the chosen model
+  double residual_rms_px = 0;  ///< inliers' residual under the chosen model (pixels)
+};
+
+/// The rotation between two views. `R_from_to_prediction` (e.g. the gyro's, through the current
+/// R_cam_imu) seeds the refinement and checks the result (SceneRotationSettings); it may be absent.
+SceneRotation estimateSceneRotation(const SceneFeatures& from, const SceneFeatures& to,
+                                    const CameraIntrinsics& intrinsics,
+                                    const std::optional<Eigen::Matrix3d>& R_from_to_prediction,
+                                    const SceneRotationSettings& settings);
+
+}  // namespace camera_imu_alignment
