@@ -27,10 +27,16 @@ struct JointPose {
   /// Gyro residuals only link consecutive poses of one group (e.g. one recording).
   int group = 0;
   double start_s = 0, end_s = 0;  ///< the rest (s)
-  /// Camera in the target frame (PnP average).
+  /// Camera in the target frame (PnP average). Without a target (camera_absolute false) the
+  /// camera in a scene frame fixed in the world, e.g. the first rest's camera frame with the
+  /// measured relative rotations (JointProblem::camera_links) chained onto it: a starting value.
   Eigen::Matrix3d R_target_cam = Eigen::Matrix3d::Identity();
-  /// Covariance of R_target_cam (rad^2, camera axes, right perturbation R Exp(delta)).
+  /// Covariance of R_target_cam (rad^2, camera axes, right perturbation R Exp(delta)); unused
+  /// when camera_absolute is false.
   Eigen::Matrix3d cov_cam_rad2 = Eigen::Matrix3d::Zero();
+  /// False: the camera's orientation is measured only relative to other poses' (the natural
+  /// scene, JointProblem::camera_links); R_target_cam is then no measurement and gets no prior.
+  bool camera_absolute = true;
   Eigen::Vector3d accel_mean_m_s2 = Eigen::Vector3d::Zero();  ///< IMU frame, mean over the rest
   Eigen::Matrix3d accel_mean_cov = Eigen::Matrix3d::Zero();   ///< (m/s^2)^2, scatter / N
   Eigen::Vector3d gyro_mean_rad_s = Eigen::Vector3d::Zero();  ///< raw mean gyro (= bias at rest)
@@ -83,6 +89,15 @@ struct AccelLink {
   double velocity_sigma_m_s = 0;
 };
 
+/// The camera's rotation between two poses measured without a target (vision/scene_rotation.h):
+/// R_cam_from_cam_to maps the `to` pose's camera vectors into the `from` pose's camera frame.
+struct CameraLink {
+  int from_pose = 0, to_pose = 0;  ///< indices into JointProblem::poses, from != to
+  Eigen::Matrix3d R_from_to = Eigen::Matrix3d::Identity();
+  /// Covariance (rad^2, `to` camera axes, right perturbation R_from_to Exp(delta)).
+  Eigen::Matrix3d cov_rad2 = Eigen::Matrix3d::Zero();
+};
+
 /// Raw gyro samples from the end of rest `from_pose` to the start of rest `to_pose`. Sample i holds
 /// over [stamps_s[i], stamps_s[i + 1]); the last one over the segment's median sample interval.
 struct GyroSegment {
@@ -101,6 +116,12 @@ struct GyroSegment {
 struct JointProblem {
   std::vector<JointPose> poses;
   std::vector<GyroSegment> segments;
+  /// Relative camera rotations between poses whose camera_absolute is false (the natural scene).
+  /// Such poses connected by links form a camera group whose rotation relative to the world is
+  /// estimated from the IMU (the first group's when no pose has an absolute camera orientation:
+  /// the world frame's gauge). A relative-only pose without a link (its links left the window)
+  /// keeps its IMU measurements; its camera tells nothing.
+  std::vector<CameraLink> camera_links;
   /// A mount change (the change-point model of mount_change.h): poses from this index on have
   /// their own R_cam_imu (JointResult::R_cam_imu_after_change), the IMU's parameters stay shared,
   /// and the gyro segment into this pose (the motion during which the mount moved) is not used.

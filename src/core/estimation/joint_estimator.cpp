@@ -461,8 +461,8 @@ JointResult JointEstimator::solve(const JointProblem& problem,
   // A motion frame's covariance is often a guess (camera_pose states none; blur and jitter grow
   // with the speed). Understated, the motion outweighs the IMU's priors and T_g's rotation, which
   // trades off with R_cam_imu without rests, absorbs the misfit (BENCHMARKS.md, BROAD): scaled.
-  // Not for the fits alone (compute_covariance false: the mount-change test compares chi2 values
-  // on the weights its one-mount estimate settled on, JointResult::motion_covariance_scale).
+  // Not for the fits alone (compute_covariance false), which compare chi-square values; the
+  // mount-change test runs on the rests alone (mount_change.h).
   double motion_scale = 1.0;
   for (int round = 0; round < joint::kMaxMotionReweights && chosen.ok &&
                       expanded.motion_nodes > 0 && settings_.compute_covariance;

@@ -238,6 +238,15 @@ ExpandedProblem expandMotion(const JointProblem& problem, const JointSettings& s
     }
     out.caller_pose.push_back(index);
   }
+  for (CameraLink link : problem.camera_links) {
+    // An index out of range stays invalid (-1) for validateProblem to name.
+    const auto map = [&](int k) {
+      return k >= 0 && static_cast<size_t>(k) < n ? out.expanded_pose[static_cast<size_t>(k)] : -1;
+    };
+    link.from_pose = map(link.from_pose);
+    link.to_pose = map(link.to_pose);
+    expanded.camera_links.push_back(link);
+  }
   // Segments between neighbours; groups follow the chains.
   const GyroStream& gyro = problem.motion_gyro;
   const double max_gap = std::max(0.1, 10.0 * medianInterval(gyro.stamps_s));

@@ -21,6 +21,10 @@ constexpr double kMinWalkDt = 1e-3;
 /// holds what the poses after a change do not determine (one pose without the magnetometer
 /// leaves the rotation about its gravity free) and is far too weak to move what they do.
 constexpr double kAfterChangeStepSigmaRad = 0.52;
+/// 1-sigma (rad) of the weak prior on the camera correction of a relative-only pose that no
+/// camera link measures (its links left the window): 30 deg, as kAfterChangeStepSigmaRad; the
+/// pose's IMU measurements still count, its camera tells nothing.
+constexpr double kUnlinkedCameraSigmaRad = 0.52;
 
 ceres::LossFunction* makeLoss(const JointSettings& settings) {
   switch (settings.robust_loss) {
@@ -85,6 +89,7 @@ class Builder {
       holdBlock(state_.e_T.data());
     }
     for (size_t k = 0; k < n; ++k) addBlock(state_.delta[k].data(), 3);
+    addCameraLinks();
     addAccelerometer();
     if (observability_.magnetometer_used) addMagnetometer();
     if (!problem_.segments.empty()) addGyro(gyro, rates_from, rates_to);
@@ -144,6 +149,7 @@ class Builder {
                                      state_.delta[k].data(), state_.accel_matrix.data(),
                                      state_.accel_bias[k].data()),
              static_cast<int>(k), -1, 3);
+      if (!pose.camera_absolute) continue;  // measured by its camera links
       auto* camera = new ceres::NormalPrior(whitening_.camera[k], ceres::Vector::Zero(3));
       record(ceres_.AddResidualBlock(camera, loss_, state_.delta[k].data()), static_cast<int>(k),
              -1, 3);
@@ -183,6 +189,43 @@ class Builder {
       }
     } else {
       for (size_t k : rests_) holdBlock(state_.accel_bias[k].data());
+    }
+  }
+
+  /// The relative camera rotations (natural scene), and the gauge they leave: with no absolute
+  /// camera orientation at all, the first pose's correction is held (the scene frame is that
+  /// pose's camera frame up to its starting value; R_world_target takes the rest). Other groups
+  /// of linked poses turn with their own correction, which the IMU determines.
+  void addCameraLinks() {
+    std::vector<bool> linked(problem_.poses.size(), false);
+    for (const CameraLink& link : problem_.camera_links) {
+      linked[static_cast<size_t>(link.from_pose)] = linked[static_cast<size_t>(link.to_pose)] =
+          true;
+    }
+    for (size_t k = 0; k < problem_.poses.size(); ++k) {
+      if (problem_.poses[k].camera_absolute || linked[k]) continue;
+      // Not recorded: no measurement, out of the chi-square and its dof.
+      ceres_.AddResidualBlock(
+          new ceres::NormalPrior(Eigen::Matrix3d::Identity() / kUnlinkedCameraSigmaRad,
+                                 ceres::Vector::Zero(3)),
+          nullptr, state_.delta[k].data());
+    }
+    const bool any_absolute =
+        std::any_of(problem_.poses.begin(), problem_.poses.end(),
+                    [](const JointPose& pose) { return pose.camera_absolute; });
+    if (!any_absolute) holdBlock(state_.delta[0].data());
+    for (size_t j = 0; j < problem_.camera_links.size(); ++j) {
+      const CameraLink& link = problem_.camera_links[j];
+      const size_t from = static_cast<size_t>(link.from_pose),
+                   to = static_cast<size_t>(link.to_pose);
+      auto* cost = new ceres::AutoDiffCostFunction<CameraLinkResidual, 3, 3, 3>(
+          new CameraLinkResidual{projectToSO3(link.R_from_to).transpose(),
+                                 projectToSO3(problem_.poses[from].R_target_cam).transpose() *
+                                     projectToSO3(problem_.poses[to].R_target_cam),
+                                 whitening_.camera_link[j]});
+      record(
+          ceres_.AddResidualBlock(cost, loss_, state_.delta[from].data(), state_.delta[to].data()),
+          static_cast<int>(from), static_cast<int>(to), 3);
     }
   }
 

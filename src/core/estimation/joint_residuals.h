@@ -298,6 +298,24 @@ struct AccelLinkResidual {
   }
 };
 
+/// A camera rotation measured between two poses without a target (JointProblem::camera_links):
+/// r = L^-1 Log(R_meas^T Exp(-delta_from) C Exp(delta_to)), C = R_target_cam_from^T R_target_cam_to
+/// of the poses' starting orientations (right perturbation in the `to` camera's axes).
+struct CameraLinkResidual {
+  Eigen::Matrix3d R_measured_transpose, C;
+  Eigen::Matrix3d whitening;  // L^-1
+
+  template <typename T>
+  bool operator()(const T* delta_from, const T* delta_to, T* residual) const {
+    const T minus_from[3] = {-delta_from[0], -delta_from[1], -delta_from[2]};
+    const Matrix3<T> model = expRotation(minus_from) * C.cast<T>() * expRotation(delta_to);
+    const Matrix3<T> error = R_measured_transpose.cast<T>() * model;
+    Eigen::Map<Vector3<T>> out(residual);
+    out = whitening.cast<T>() * logRotation(error);
+    return true;
+  }
+};
+
 /// Bias random walk (gyro or accelerometer) between consecutive rests: r = (b_to - b_from) / sigma.
 struct BiasWalkResidual {
   double inverse_sigma;  // 1 / (walk * sqrt(dt)), in the bias' inverse units

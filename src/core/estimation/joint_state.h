@@ -57,6 +57,7 @@ struct State {
 struct Whitening {
   std::vector<Eigen::Matrix3d> accel, gyro_mean, mag_ut, camera;  ///< per pose
   std::vector<Eigen::Matrix3d> gyro_relative;                     ///< per segment (1/rad)
+  std::vector<Eigen::Matrix3d> camera_link;  ///< per JointProblem::camera_links entry (1/rad)
 };
 
 /// Which pose (or two) a residual block belongs to, for the per-pose residual norms.

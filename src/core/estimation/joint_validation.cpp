@@ -94,6 +94,27 @@ std::string validatePose(const JointPose& pose, size_t k, const JointSettings& s
   return "";
 }
 
+std::string validateCameraLinks(const JointProblem& problem, const JointSettings& s) {
+  const int n = static_cast<int>(problem.poses.size());
+  for (size_t j = 0; j < problem.camera_links.size(); ++j) {
+    const CameraLink& link = problem.camera_links[j];
+    const std::string name = "camera link " + std::to_string(j);
+    if (link.from_pose < 0 || link.from_pose >= n || link.to_pose < 0 || link.to_pose >= n ||
+        link.from_pose == link.to_pose) {
+      return name + ": needs two different poses in 0.." + std::to_string(n - 1);
+    }
+    if (problem.poses[link.from_pose].camera_absolute ||
+        problem.poses[link.to_pose].camera_absolute) {
+      return name + ": links poses whose camera orientation is absolute (camera_absolute)";
+    }
+    if (!isRotationMatrix(link.R_from_to, 1e-3)) return name + ": R_from_to is not a rotation";
+    if (!usableCovariance(link.cov_rad2, s.camera_sigma_floor_rad)) {
+      return name + ": cov_rad2 is not a finite symmetric positive semi-definite matrix";
+    }
+  }
+  return "";
+}
+
 std::string validateSegment(const GyroSegment& segment, size_t j, const JointProblem& problem) {
   const std::string name = "gyro segment " + std::to_string(j);
   const int n = static_cast<int>(problem.poses.size());
@@ -163,6 +184,8 @@ std::string validateProblem(const JointProblem& problem, const Eigen::Matrix3d& 
     error = validatePose(problem.poses[k], k, settings);
     if (!error.empty()) return error;
   }
+  error = validateCameraLinks(problem, settings);
+  if (!error.empty()) return error;
   std::set<int> from_poses;
   for (size_t j = 0; j < problem.segments.size(); ++j) {
     error = validateSegment(problem.segments[j], j, problem);
@@ -221,6 +244,14 @@ bool computeWhitening(const JointProblem& problem, const std::vector<GyroPreinte
     }
     if (!ok) {
       *error = "pose " + std::to_string(k) + ": a measurement covariance is not usable";
+      return false;
+    }
+  }
+  w->camera_link.assign(problem.camera_links.size(), Eigen::Matrix3d::Zero());
+  for (size_t j = 0; j < problem.camera_links.size(); ++j) {
+    if (!whiteningMatrix(problem.camera_links[j].cov_rad2, settings.camera_sigma_floor_rad,
+                         &w->camera_link[j])) {
+      *error = "camera link " + std::to_string(j) + ": its covariance is not usable";
       return false;
     }
   }

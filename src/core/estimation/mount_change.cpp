@@ -63,9 +63,6 @@ JointProblem withFieldsOf(const JointProblem& problem, const JointResult& one_mo
     if (!keep) pose.mag_mean_t.reset();
     pose.mag_flagged = false;
   }
-  // The motion frames weighed as in the one-mount estimate (its chi2 is compared).
-  for (MotionFrame& frame : out.motion_frames)
-    frame.cov_cam_rad2 *= one_mount.motion_covariance_scale;
   return out;
 }
 
