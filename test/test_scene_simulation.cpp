@@ -352,6 +352,9 @@ TEST(SceneSimulateBag, RoomRobotBagHasImagesAndNoCameraPose) {
   EXPECT_EQ(truth["poses"].size(), 3u);
   EXPECT_TRUE(truth["poses"][0]["q_world_cam_xyzw"]);
   EXPECT_FALSE(std::ifstream(test::bagStem(bag) + ".target.yaml").good()) << "no board";
+  const test::ToolRun help = test::runTool(sim_exe + " --help");
+  for (const char* word : {"room_robot:", "room_handheld:", "--moving-objects", "--texture-poor"})
+    EXPECT_NE(help.out.find(word), std::string::npos) << word;
   // A board's options are refused with the room, and the room's with a board.
   test::ToolRun r =
       test::runTool(sim_exe + " --out " + test::tempPath("x.bag") + small + " --camera-pose");

@@ -15,8 +15,8 @@
 // with cells of 0.6, 0.22, 0.08 and 0.03 m, each drawn from a hash of (scene seed, surface, layer,
 // cell): the same point has the same grey from every view, so views of a surface are related by
 // the exact projective geometry. The finer layers are painted over the coarser ones. Texture-poor:
-// the surfaces' greys close together and the shapes' contrast x0.04 (a step of about 2 grey
-// levels, below SIFT's contrast threshold): a near-blank room.
+// the surfaces' greys close together and the shapes' contrast x0.04 (steps of at most about 5
+// grey levels, below SIFT's contrast threshold): a near-blank room.
 #pragma once
 
 #include <Eigen/Core>
