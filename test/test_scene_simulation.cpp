@@ -327,6 +327,53 @@ TEST(SceneRendering, RichRoomsHaveManyFeaturesAndTexturePoorOnesFew) {
   }
 }
 
+TEST(SceneRendering, ConsecutiveRestsShareFeaturesWhereTheGeometrySaysSo) {
+  // SIFT between the first two rests of each scenario: a match is right when the keypoint of the
+  // first view, lifted to 3D with its depth and the true poses, projects within 2 px of its match
+  // in the second. The views must share many right matches (what a natural-scene calibration
+  // needs), and most ratio-test matches must be right (the rendering is geometrically exact).
+  for (const char* scenario : {"room_robot", "room_handheld"}) {
+    const sim::SimulationConfig config = roomConfig(scenario, 1);
+    const sim::Trajectory trajectory(config);
+    const sim::SceneRenderer renderer(sim::CameraModel::fromConfig(config),
+                                      sim::RoomScene::fromConfig(config), config.supersample,
+                                      config.blur_sigma_px);
+    const sim::StationaryPose& a = trajectory.poses()[0];
+    const sim::StationaryPose& b = trajectory.poses()[1];
+    const cv::Ptr<cv::SIFT> sift = cv::SIFT::create();
+    std::vector<cv::KeyPoint> keys_a, keys_b;
+    cv::Mat desc_a, desc_b;
+    sift->detectAndCompute(
+        sim::ImageRenderer::toMono8(renderer.render(a.R_world_cam, a.p_world_cam), 1.5, 1),
+        cv::noArray(), keys_a, desc_a);
+    sift->detectAndCompute(
+        sim::ImageRenderer::toMono8(renderer.render(b.R_world_cam, b.p_world_cam), 1.5, 2),
+        cv::noArray(), keys_b, desc_b);
+    const cv::Mat depth_a = renderer.depth(a.R_world_cam, a.p_world_cam);
+    std::vector<std::vector<cv::DMatch>> knn;
+    cv::BFMatcher(cv::NORM_L2).knnMatch(desc_a, desc_b, knn, 2);
+    const sim::CameraModel& cam = renderer.camera();
+    int matches = 0, right = 0;
+    for (const auto& m : knn) {
+      if (m.size() < 2 || m[0].distance > 0.75 * m[1].distance) continue;
+      ++matches;
+      const cv::Point2f pa = keys_a[m[0].queryIdx].pt, pb = keys_b[m[0].trainIdx].pt;
+      const float z = depth_a.at<float>(static_cast<int>(std::lround(pa.y)),
+                                        static_cast<int>(std::lround(pa.x)));
+      const Eigen::Vector3d in_a(z * (pa.x - cam.cx) / cam.fx, z * (pa.y - cam.cy) / cam.fy, z);
+      const Eigen::Vector3d world = a.R_world_cam * in_a + a.p_world_cam;
+      const Eigen::Vector2d expected =
+          cam.project(b.R_world_cam.transpose() * (world - b.p_world_cam));
+      right += (expected - Eigen::Vector2d(pb.x, pb.y)).norm() < 2.0;
+    }
+    std::cout << scenario << " seed 1, rests 0-1: " << keys_a.size() << " and " << keys_b.size()
+              << " SIFT features, " << matches << " ratio-test matches, " << right
+              << " where the geometry puts them\n";
+    EXPECT_GT(right, 100) << scenario;
+    EXPECT_GT(right, matches / 2) << scenario;
+  }
+}
+
 TEST(SceneSimulateBag, RoomRobotBagHasImagesAndNoCameraPose) {
   const std::string sim_exe = SIMULATE_BAG_EXE;
   const std::string small =
