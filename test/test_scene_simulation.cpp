@@ -397,7 +397,25 @@ TEST(SceneSimulateBag, RoomRobotBagHasImagesAndNoCameraPose) {
   EXPECT_EQ(truth["scene"]["type"].as<std::string>(), "room");
   EXPECT_FALSE(truth["target"]);
   EXPECT_EQ(truth["poses"].size(), 3u);
-  EXPECT_TRUE(truth["poses"][0]["q_world_cam_xyzw"]);
+  // The truth's rests are the simulator's: the same configuration gives the same camera in the
+  // room frame (what a test of the natural-scene rotation compares relative rotations against).
+  sim::SimulationConfig config = roomConfig("room_robot", 4);
+  config.num_poses = 3;
+  config.hold_min_s = config.move_min_s = 1.0;
+  config.hold_max_s = config.move_max_s = 1.5;
+  config.width = 160;
+  config.height = 120;
+  config.fx = config.fy = 125.0;
+  config.cx = 79.5;
+  config.cy = 59.5;
+  const sim::Trajectory trajectory(config);
+  for (size_t k = 0; k < 3; ++k) {
+    const auto q = truth["poses"][k]["q_world_cam_xyzw"].as<std::vector<double>>();
+    ASSERT_EQ(q.size(), 4u);
+    const Eigen::Quaterniond q_truth(q[3], q[0], q[1], q[2]);
+    EXPECT_LT(q_truth.angularDistance(Eigen::Quaterniond(trajectory.poses()[k].R_world_cam)), 1e-9)
+        << "rest " << k;
+  }
   EXPECT_FALSE(std::ifstream(test::bagStem(bag) + ".target.yaml").good()) << "no board";
   const test::ToolRun help = test::runTool(sim_exe + " --help");
   for (const char* word : {"room_robot:", "room_handheld:", "--moving-objects", "--texture-poor"})
