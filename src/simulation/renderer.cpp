@@ -3,6 +3,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <utility>
@@ -60,26 +61,21 @@ bool CameraModel::undistort(const Eigen::Vector2d& pixel, Eigen::Vector2d* xy) c
   return x.allFinite() && (distort(x) - xd).norm() < 1e-9;
 }
 
-ImageRenderer::ImageRenderer(const CameraModel& camera, TargetTexture texture, int supersample,
-                             double blur_sigma_px, Photometry photometry)
-    : camera_(camera),
-      texture_(std::move(texture)),
-      supersample_(supersample),
-      blur_sigma_(blur_sigma_px),
-      photometry_(photometry) {
-  const int S = supersample_, W = camera_.width * S, H = camera_.height * S;
-  ray_x_.create(H, W, CV_32F);
-  ray_y_.create(H, W, CV_32F);
-  const bool distorted = camera_.distortion != std::array<double, 5>{0.0, 0.0, 0.0, 0.0, 0.0};
+void undistortedRayGrid(const CameraModel& camera, int supersample, cv::Mat* ray_x,
+                        cv::Mat* ray_y) {
+  const int S = supersample, W = camera.width * S, H = camera.height * S;
+  ray_x->create(H, W, CV_32F);
+  ray_y->create(H, W, CV_32F);
+  const bool distorted = camera.distortion != std::array<double, 5>{0.0, 0.0, 0.0, 0.0, 0.0};
   cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& range) {
     for (int i = range.start; i < range.end; ++i) {
-      float* rx = ray_x_.ptr<float>(i);
-      float* ry = ray_y_.ptr<float>(i);
+      float* rx = ray_x->ptr<float>(i);
+      float* ry = ray_y->ptr<float>(i);
       const double v = (i + 0.5) / S - 0.5;
       for (int j = 0; j < W; ++j) {
         const double u = (j + 0.5) / S - 0.5;
-        Eigen::Vector2d xy((u - camera_.cx) / camera_.fx, (v - camera_.cy) / camera_.fy);
-        if (distorted && !camera_.undistort(Eigen::Vector2d(u, v), &xy)) {
+        Eigen::Vector2d xy((u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy);
+        if (distorted && !camera.undistort(Eigen::Vector2d(u, v), &xy)) {
           xy.setConstant(std::numeric_limits<double>::quiet_NaN());
         }
         rx[j] = static_cast<float>(xy.x());
@@ -87,6 +83,47 @@ ImageRenderer::ImageRenderer(const CameraModel& camera, TargetTexture texture, i
       }
     }
   });
+}
+
+cv::Mat finishImage(const cv::Mat& sampled, const CameraModel& camera, int supersample,
+                    const Photometry& photometry, double blur_sigma_px) {
+  cv::Mat image;
+  if (supersample > 1) {
+    cv::resize(sampled, image, cv::Size(camera.width, camera.height), 0, 0, cv::INTER_AREA);
+  } else {
+    image = sampled;
+  }
+  image = photometry.black + (photometry.white - photometry.black) * image;
+  if (blur_sigma_px > 0.0) cv::GaussianBlur(image, image, cv::Size(0, 0), blur_sigma_px);
+  return image;
+}
+
+cv::Mat exposureAverage(const Trajectory& trajectory, double t, double exposure_s,
+                        const std::function<cv::Mat(double)>& view) {
+  const bool moving = trajectory.at(t).pose < 0 || trajectory.at(t - 0.5 * exposure_s).pose < 0 ||
+                      trajectory.at(t + 0.5 * exposure_s).pose < 0;
+  if (exposure_s <= 0.0 || !moving) return view(t);
+  constexpr int kSubframes = 5;
+  cv::Mat sum;
+  for (int i = 0; i < kSubframes; ++i) {
+    const cv::Mat frame = view(t + exposure_s * ((i + 0.5) / kSubframes - 0.5));
+    if (sum.empty()) {
+      sum = frame.clone();
+    } else {
+      sum += frame;
+    }
+  }
+  return sum / kSubframes;
+}
+
+ImageRenderer::ImageRenderer(const CameraModel& camera, TargetTexture texture, int supersample,
+                             double blur_sigma_px, Photometry photometry)
+    : camera_(camera),
+      texture_(std::move(texture)),
+      supersample_(supersample),
+      blur_sigma_(blur_sigma_px),
+      photometry_(photometry) {
+  undistortedRayGrid(camera_, supersample_, &ray_x_, &ray_y_);
 }
 
 cv::Mat ImageRenderer::render(const Eigen::Matrix3d& R, const Eigen::Vector3d& c) const {
@@ -114,17 +151,10 @@ cv::Mat ImageRenderer::render(const Eigen::Matrix3d& R, const Eigen::Vector3d& c
       }
     }
   });
-  cv::Mat sampled, image;
+  cv::Mat sampled;
   cv::remap(tex.reflectance, sampled, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
             cv::Scalar(photometry_.background));
-  if (supersample_ > 1) {
-    cv::resize(sampled, image, cv::Size(camera_.width, camera_.height), 0, 0, cv::INTER_AREA);
-  } else {
-    image = sampled;
-  }
-  image = photometry_.black + (photometry_.white - photometry_.black) * image;
-  if (blur_sigma_ > 0.0) cv::GaussianBlur(image, image, cv::Size(0, 0), blur_sigma_);
-  return image;
+  return finishImage(sampled, camera_, supersample_, photometry_, blur_sigma_);
 }
 
 cv::Mat ImageRenderer::renderAt(const Trajectory& trajectory, double t, double exposure_s) const {
@@ -135,20 +165,7 @@ cv::Mat ImageRenderer::renderAt(const Trajectory& trajectory, double t, double e
         trajectory.R_world_target().transpose() * (st.p_world_cam - trajectory.p_world_target());
     return render(R_target_cam, p_target_cam);
   };
-  const bool moving = trajectory.at(t).pose < 0 || trajectory.at(t - 0.5 * exposure_s).pose < 0 ||
-                      trajectory.at(t + 0.5 * exposure_s).pose < 0;
-  if (exposure_s <= 0.0 || !moving) return view(t);
-  constexpr int kSubframes = 5;
-  cv::Mat sum;
-  for (int i = 0; i < kSubframes; ++i) {
-    const cv::Mat frame = view(t + exposure_s * ((i + 0.5) / kSubframes - 0.5));
-    if (sum.empty()) {
-      sum = frame.clone();
-    } else {
-      sum += frame;
-    }
-  }
-  return sum / kSubframes;
+  return exposureAverage(trajectory, t, exposure_s, view);
 }
 
 cv::Mat ImageRenderer::toMono8(const cv::Mat& grey, double noise_sigma, std::uint64_t noise_seed) {

@@ -37,6 +37,14 @@ const std::vector<std::pair<std::string, std::string>>& scenarioList() {
        "iron"},
       {"noisy_consumer",
        "nominal with the noisy grade: MPU-6050/9250 on a vibrating mount, gyro bias 3 deg/s"},
+      {"room_robot",
+       "no board: a ground robot in a textured 6 x 5 m room with boxes, camera ~0.4 m high; 12 "
+       "stops of 3-5 s, 0.3-2 m apart, turning 10-60 deg, tilted 5-20 deg by uneven ground, "
+       "consecutive views overlapping (any --imu-grade; --moving-objects, --texture-poor)"},
+      {"room_handheld",
+       "no board: a hand-held rig in the textured room, 12 rests of 3-5 s turned 20-60 deg about "
+       "all axes, small translations, walls and boxes 1-3 m away, consecutive views overlapping "
+       "(any --imu-grade; --moving-objects, --texture-poor)"},
   };
   return list;
 }
@@ -100,6 +108,15 @@ bool applyScenario(const std::string& name, SimulationConfig* config) {
     applyImuGrade(ImuGrade::kConsumer, &c);
   } else if (name == "noisy_consumer") {
     applyImuGrade(ImuGrade::kNoisy, &c);
+  } else if (name == "room_robot") {
+    // Driving 0.3-2 m and turning between stops takes a robot longer than a hand a turn.
+    c.motion = MotionKind::kRoomRobot;
+    c.move_min_s = 3.0;
+    c.move_max_s = 5.0;
+    c.supersample = 2;  // the room's procedural texture costs per sample: 4 per pixel, not 9
+  } else if (name == "room_handheld") {
+    c.motion = MotionKind::kRoomHandheld;
+    c.supersample = 2;
   } else {
     return false;
   }
@@ -153,6 +170,11 @@ std::string validateConfig(const SimulationConfig& c) {
     e << "remount rotation must be finite and at most 180 deg; ";
   if (!std::isfinite(c.remount_time_s)) e << "remount_time_s must be finite; ";
   if (!inRange(c.start_time_s, 1.0, 4e9)) e << "start_time_s must be in [1, 4e9]; ";
+  if (!isRoomMotion(c.motion) && (c.moving_objects || c.texture_poor))
+    e << "moving objects and texture-poor are options of the room scenarios (room_robot, "
+         "room_handheld); ";
+  if (isRoomMotion(c.motion) && c.camera_pose)
+    e << "camera_pose gives the camera in the board's frame: the room scenarios have no board; ";
   const SensorNoise& n = c.imu_noise;
   bool noise_ok = inRange(n.magnetometer_noise_sigma, 0, 1e-4);
   for (double v : {n.accelerometer_noise_density, n.accelerometer_random_walk,
@@ -195,6 +217,10 @@ const char* toString(MotionKind kind) {
       return "small_angle";
     case MotionKind::kWaving:
       return "waving";
+    case MotionKind::kRoomRobot:
+      return "room_robot";
+    case MotionKind::kRoomHandheld:
+      return "room_handheld";
     default:
       return "full";
   }

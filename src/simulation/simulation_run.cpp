@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "camera_imu_alignment/simulation/room_scene.h"
 #include "camera_imu_alignment/simulation/target.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 
@@ -205,28 +206,39 @@ std::string truthYaml(const SimulationRun& run) {
     << std::setprecision(16);
   for (const StationaryPose& p : tr.poses())
     o << "  - [" << t0 + p.start_s << ", " << t0 + p.end_s << "]\n";
-  o << std::setprecision(12) << "poses:" << none << "  # true orientations during each hold\n";
+  const bool room = isRoomMotion(c.motion);  // no board: no target frame, the room's = world
+  o << std::setprecision(12) << "poses:" << none << "  # true orientations during each hold"
+    << (room ? "; world = the room frame (scene:)" : "") << "\n";
   for (size_t k = 0; k < tr.poses().size(); ++k) {
     const StationaryPose& p = tr.poses()[k];
     const RigState st = tr.at(0.5 * (p.start_s + p.end_s));
     o << "  - index: " << k << "\n    q_world_imu_xyzw: ";
     w.quat(st.R_world_imu());
-    o << "\n    q_target_cam_xyzw: ";
-    w.quat(tr.R_world_target().transpose() * p.R_world_cam);
+    if (!room) {
+      o << "\n    q_target_cam_xyzw: ";
+      w.quat(tr.R_world_target().transpose() * p.R_world_cam);
+    }
     o << "\n    q_world_cam_xyzw: ";
     w.quat(p.R_world_cam);
     o << "\n    p_world_cam_m: ";
     w.vec(p.p_world_cam);
-    o << "\n    p_target_cam_m: ";
-    w.vec(tr.R_world_target().transpose() * (p.p_world_cam - tr.p_world_target()));
+    if (!room) {
+      o << "\n    p_target_cam_m: ";
+      w.vec(tr.R_world_target().transpose() * (p.p_world_cam - tr.p_world_target()));
+    }
     o << "\n";
   }
-  o << "target:  # pose of the target frame in the world (see the target YAML)\n  type: "
-    << toString(c.target.type) << "\n  R_world_target:\n";
-  w.rotation("    ", tr.R_world_target());
-  o << "  p_world_target_m: ";
-  w.vec(tr.p_world_target());
-  o << "\ncamera:\n  width: " << c.width << "\n  height: " << c.height
+  if (room) {
+    o << RoomScene::fromConfig(c).yaml();
+  } else {
+    o << "target:  # pose of the target frame in the world (see the target YAML)\n  type: "
+      << toString(c.target.type) << "\n  R_world_target:\n";
+    w.rotation("    ", tr.R_world_target());
+    o << "  p_world_target_m: ";
+    w.vec(tr.p_world_target());
+    o << "\n";
+  }
+  o << "camera:\n  width: " << c.width << "\n  height: " << c.height
     << "\n  rate_hz: " << c.camera_rate_hz << "\n  K: [" << c.fx << ", 0, " << c.cx << ", 0, "
     << c.fy << ", " << c.cy << ", 0, 0, 1]\n  distortion_model: plumb_bob\n  D: ["
     << c.distortion[0] << ", " << c.distortion[1] << ", " << c.distortion[2] << ", "

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "camera_imu_alignment/simulation/room_motion.h"
 #include "camera_imu_alignment/simulation/target.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 
@@ -65,6 +66,20 @@ Trajectory::Trajectory(const SimulationConfig& config) {
     remount_time_ = config.remount_time_s >= 0.0 ? config.remount_time_s : 0.5 * duration_;
     return;
   }
+  if (isRoomMotion(config.motion)) {
+    // No board: the target frame is the room's (= world), the rests look into the room.
+    R_world_target_.setIdentity();
+    p_world_target_.setZero();
+    poses_ = roomRests(config, RoomScene::fromConfig(config), &rng);
+    double t = 0.0;
+    for (size_t k = 0; k < poses_.size(); ++k) {
+      poses_[k].start_s = t;
+      poses_[k].end_s = t + config.hold_min_s + (config.hold_max_s - config.hold_min_s) * uni(rng);
+      t = poses_[k].end_s + config.move_min_s + (config.move_max_s - config.move_min_s) * uni(rng);
+    }
+    finishPoses(config);
+    return;
+  }
   double max_tilt = deg2rad(config.max_tilt_deg), max_roll = deg2rad(config.max_roll_deg);
   if (config.motion == MotionKind::kSmallAngle) {
     max_tilt = std::min(max_tilt, deg2rad(4.0));
@@ -99,8 +114,12 @@ Trajectory::Trajectory(const SimulationConfig& config) {
     if (k + 1 < n) t += config.move_min_s + (config.move_max_s - config.move_min_s) * uni(rng);
     poses_.push_back(pose);
   }
-  duration_ = poses_.back().end_s;
+  finishPoses(config);
+}
 
+void Trajectory::finishPoses(const SimulationConfig& config) {
+  const int n = static_cast<int>(poses_.size());
+  duration_ = poses_.back().end_s;
   if (remount_) {
     const int k = std::max(0, n / 2 - 1);
     remount_time_ = config.remount_time_s >= 0.0

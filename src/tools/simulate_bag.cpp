@@ -22,6 +22,8 @@
 #include <sstream>
 
 #include "camera_imu_alignment/simulation/renderer.h"
+#include "camera_imu_alignment/simulation/room_scene.h"
+#include "camera_imu_alignment/simulation/scene_renderer.h"
 #include "camera_imu_alignment/simulation/simulation_run.h"
 #include "camera_imu_alignment/simulation/target.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
@@ -38,7 +40,8 @@ std::string usage() {
   o << "usage: simulate_bag --out FILE.bag [--seed N] [--scenario NAME] [options]\n"
        "  Writes FILE.bag (sensor_msgs/Imu, MagneticField, Image mono8, CameraInfo; with\n"
        "  --camera-pose geometry_msgs/PoseStamped), FILE.truth.yaml\n"
-       "  (R_cam_imu, stationary intervals, true poses, noise) and FILE.target.yaml (Kalibr).\n"
+       "  (R_cam_imu, stationary intervals, true poses, noise) and FILE.target.yaml (Kalibr;\n"
+       "  the room scenarios have no board: no target file, no camera pose).\n"
        "Scenarios (presets; options below override them):\n";
   for (const auto& s : sim::scenarioList()) o << "  " << s.first << ": " << s.second << "\n";
   o << "IMU grades (--imu-grade NAME; after the scenario, before the noise options below):\n";
@@ -141,12 +144,23 @@ int writeBag(const sim::SimulationRun& run, const std::string& path, const BagOp
   if (mag_frame != c.imu_frame && c.magnetometer) {
     bag.write("/tf_static", ros::Time(c.start_time_s), magnetometerTf(c, options));
   }
-  std::optional<sim::ImageRenderer> renderer;  // --no-images: no texture, nothing rendered
-  if (c.images) {
+  // --no-images: no texture, nothing rendered. The room scenarios see the room, the others the
+  // board.
+  const bool room = sim::isRoomMotion(c.motion);
+  std::optional<sim::ImageRenderer> renderer;
+  std::optional<sim::SceneRenderer> scene_renderer;
+  if (c.images && room) {
+    scene_renderer.emplace(sim::CameraModel::fromConfig(c), sim::RoomScene::fromConfig(c),
+                           c.supersample, c.blur_sigma_px);
+  } else if (c.images) {
     renderer.emplace(sim::CameraModel::fromConfig(c),
                      sim::makeTargetTexture(c.target, sim::textureTexelFor(c)), c.supersample,
                      c.blur_sigma_px);
   }
+  const auto renderAt = [&](double t, double exposure_s) {
+    return room ? scene_renderer->renderAt(run.trajectory, t, exposure_s)
+                : renderer->renderAt(run.trajectory, t, exposure_s);
+  };
 
   // IMU and magnetometer messages up to a bag time, in sample order (bag time = true sample time;
   // injected out-of-order stamps only change the header stamps).
@@ -199,7 +213,8 @@ int writeBag(const sim::SimulationRun& run, const std::string& path, const BagOp
     }
   };
 
-  // Camera frames; a stationary pose is rendered once and only the pixel noise changes.
+  // Camera frames; a stationary pose is rendered once and only the pixel noise changes (unless
+  // objects move in the scene: then every frame is rendered).
   const sensor_msgs::CameraInfo info_template = cameraInfo(c, options.camera_info_focal_scale);
   const double exposure = c.motion_blur_exposure_s;
   int rendered = 0, cached_pose = -1;
@@ -215,15 +230,15 @@ int writeBag(const sim::SimulationRun& run, const std::string& path, const BagOp
     const int pose_a = run.trajectory.at(t - 0.5 * exposure).pose;
     const int pose_b = run.trajectory.at(t + 0.5 * exposure).pose;
     cv::Mat grey;
-    if (pose_a >= 0 && pose_a == pose_b) {
+    if (pose_a >= 0 && pose_a == pose_b && !c.moving_objects) {
       if (cached_pose != pose_a) {
-        cached = renderer->renderAt(run.trajectory, t, exposure);
+        cached = renderAt(t, exposure);
         cached_pose = pose_a;
         ++rendered;
       }
       grey = cached;
     } else {
-      grey = renderer->renderAt(run.trajectory, t, exposure);
+      grey = renderAt(t, exposure);
       ++rendered;
     }
     const cv::Mat mono = sim::ImageRenderer::toMono8(grey, c.noise_scale * c.pixel_noise_sigma,
@@ -282,7 +297,8 @@ int main(int argc, char** argv) {
     const auto start = std::chrono::steady_clock::now();
     const sim::SimulationRun run(config);
     const std::string base = out.substr(0, out.size() - 4);
-    writeText(base + ".target.yaml", sim::targetYaml(config.target));
+    const bool room = sim::isRoomMotion(config.motion);  // no board: no target file
+    if (!room) writeText(base + ".target.yaml", sim::targetYaml(config.target));
     writeText(base + ".truth.yaml", sim::truthYaml(run));
     const int rendered = writeBag(run, out, bag_options);
     const double secs =
@@ -293,7 +309,9 @@ int main(int argc, char** argv) {
               << " images, " << rendered << " rendered, "
               << (config.camera_pose ? run.camera_orientations.size() : 0) << " camera poses) in "
               << secs << " s\n"
-              << "simulate_bag: wrote " << base << ".truth.yaml and " << base << ".target.yaml\n";
+              << "simulate_bag: wrote " << base << ".truth.yaml"
+              << (room ? " (a room scene: no board, no target file)\n"
+                       : " and " + base + ".target.yaml\n");
     return 0;
   } catch (const cia::UsageError& e) {
     std::cerr << "simulate_bag: " << e.what() << "\n" << usage();

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 #include "camera_imu_alignment/config/settings_error.h"
 #include "camera_imu_alignment/simulation/imu_grades.h"
@@ -165,6 +166,13 @@ const std::vector<Key>& simulateBagOptionTable() {
                      "viewing direction off the target normal"),
       number<double>("--max-roll-deg", CIA_MEMBER(config.max_roll_deg), within(0, 180), "deg",
                      "rotation about the optical axis"),
+      flag(
+          "--moving-objects", [](Options* o) { o->config.moving_objects = true; },
+          "room scenarios: the two largest boxes slide 0.2-0.5 m back and forth, during the rests "
+          "too (every frame is then rendered)"),
+      flag(
+          "--texture-poor", [](Options* o) { o->config.texture_poor = true; },
+          "room scenarios: near-blank surfaces, faint texture (few features)"),
       list(
           "--r-cam-imu", 4,
           [](const Options& o) {
@@ -418,6 +426,21 @@ SimulateBagOptions parseSimulateBagOptions(const CliArgs& args) {
       (o.bag.mag_frame.empty() || o.bag.mag_frame == c.imu_frame)) {
     throw SettingsError(source, "--mag-frame-yaw-deg",
                         "--mag-frame-yaw-deg needs a --mag-frame other than the IMU's frame");
+  }
+  const bool room = sim::isRoomMotion(c.motion);
+  for (const auto& [given, name] : {std::make_pair(c.moving_objects, "--moving-objects"),
+                                    std::make_pair(c.texture_poor, "--texture-poor")}) {
+    if (given && !room) {
+      throw SettingsError(source, name,
+                          std::string(name) +
+                              " changes the room scene: use it with --scenario room_robot or "
+                              "room_handheld");
+    }
+  }
+  if (room && c.camera_pose) {
+    throw SettingsError(source, "--camera-pose",
+                        "--camera-pose gives the camera in the board's frame: --scenario " +
+                            c.scenario + " has no board");
   }
   if (!c.images && !c.camera_pose) {
     throw SettingsError(source, "--no-images",

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <opencv2/core.hpp>
 
 #include "camera_imu_alignment/simulation/sim_config.h"
@@ -44,6 +45,22 @@ struct Photometry {
   double black = 25.0, white = 225.0;  ///< grey levels of reflectance 0 and 1
   double background = 0.45;            ///< reflectance outside the board
 };
+
+/// The undistorted normalised coordinates (x/z, y/z; NaN where undistortion fails) of every
+/// supersample of `camera`'s image: CV_32F, (height * supersample) x (width * supersample), the
+/// supersample (i, j) centred on pixel ((j + 0.5) / S - 0.5, (i + 0.5) / S - 0.5). Computed once
+/// per renderer: the ray of every sample in the camera frame is (x, y, 1).
+void undistortedRayGrid(const CameraModel& camera, int supersample, cv::Mat* ray_x, cv::Mat* ray_y);
+
+/// The path every render ends with: the supersampled reflectance (CV_32F, 0-1) box-averaged into
+/// pixels, mapped to grey levels by `photometry`, Gaussian-blurred by blur_sigma_px (CV_32F).
+cv::Mat finishImage(const cv::Mat& sampled_reflectance, const CameraModel& camera, int supersample,
+                    const Photometry& photometry, double blur_sigma_px);
+
+/// The motion-blur rule of renderAt: with exposure_s > 0 and the rig moving at t or at either end
+/// of the exposure, the mean of view() at 5 times spread over it; else view(t).
+cv::Mat exposureAverage(const Trajectory& trajectory, double t, double exposure_s,
+                        const std::function<cv::Mat(double)>& view);
 
 class ImageRenderer {
  public:

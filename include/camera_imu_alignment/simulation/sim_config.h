@@ -18,12 +18,20 @@ namespace simulation {
 
 /// How the rig moves between stationary poses.
 enum class MotionKind {
-  kFull,        ///< roll, pitch and yaw diversity with some translation: all axes excited
-  kSingleAxis,  ///< rotations about the optical axis only (degenerate: one axis unobservable)
-  kSmallAngle,  ///< full motion but within a few degrees (poorly conditioned)
-  kWaving,      ///< continuous hand-held motion, no rests (waving_motion.h); num_poses, hold and
-                ///< move times unused, the run lasts waving_duration_s
+  kFull,          ///< roll, pitch and yaw diversity with some translation: all axes excited
+  kSingleAxis,    ///< rotations about the optical axis only (degenerate: one axis unobservable)
+  kSmallAngle,    ///< full motion but within a few degrees (poorly conditioned)
+  kWaving,        ///< continuous hand-held motion, no rests (waving_motion.h); num_poses, hold and
+                  ///< move times unused, the run lasts waving_duration_s
+  kRoomRobot,     ///< a ground robot stopping in a textured room, no board (room_motion.h)
+  kRoomHandheld,  ///< a hand-held rig resting in a textured room, no board (room_motion.h)
 };
+
+/// True for the natural-scene motions (kRoomRobot, kRoomHandheld): the camera sees the room of
+/// room_scene.h instead of a board, and there is no target frame.
+inline bool isRoomMotion(MotionKind kind) {
+  return kind == MotionKind::kRoomRobot || kind == MotionKind::kRoomHandheld;
+}
 
 enum class TargetType { kCheckerboard, kAprilgrid, kCirclegrid };
 
@@ -50,6 +58,10 @@ struct SimulationConfig {
   double max_roll_deg = 80.0;                          ///< rotation about the optical axis
   double min_distance_m = 0.55, max_distance_m = 0.9;  ///< camera to target centre
   double waving_duration_s = 60.0;                     ///< length of a kWaving run
+
+  // Natural scene (room motions only; room_scene.h).
+  bool moving_objects = false;  ///< the two largest boxes slide 0.2-0.5 m back and forth
+  bool texture_poor = false;    ///< near-blank surfaces: faint texture, few features
 
   // Mounting. Random per seed (at least 30 deg from the identity) unless given.
   bool given_R_cam_imu = false;

@@ -72,7 +72,9 @@ struct SimulationRun {
 /// The truth YAML (R_cam_imu in the result format of doc/CONVENTIONS.md, stationary intervals
 /// in bag time, per-pose orientations, noise settings, seed, scenario, injections) and the
 /// `imu_errors:` block (grade, T_g, T_a, initial biases and walks, hard and soft iron, noise
-/// densities; written with 17 digits, so it reads back exactly).
+/// densities; written with 17 digits, so it reads back exactly). The room scenarios have no board:
+/// their poses carry the camera in the world = room frame only (q_world_cam_xyzw, p_world_cam_m),
+/// and a `scene:` block (RoomScene::yaml) takes the place of `target:`.
 std::string truthYaml(const SimulationRun& run);
 
 }  // namespace simulation

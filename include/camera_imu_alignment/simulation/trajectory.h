@@ -1,7 +1,9 @@
 // Ground-truth motion of the simulated rig: N stationary poses in front of a planar target fixed in
 // the world, joined by minimum-jerk rotation + translation segments (or, for MotionKind::kWaving,
-// continuous hand-held motion without rests: waving_motion.h), and the (possibly remounted)
-// mounting R_cam_imu(t). Everything is analytic: orientation, body rate and acceleration are exact.
+// continuous hand-held motion without rests: waving_motion.h; for the room motions, rests in a
+// textured room without a board, room_motion.h, the target frame then being the room's = world),
+// and the (possibly remounted) mounting R_cam_imu(t). Everything is analytic: orientation, body
+// rate and acceleration are exact.
 //
 // Frames: world ENU (z up). Target frame as Kalibr's (x along the columns, y along the rows, z out
 // of the printed face towards the camera); the target hangs on a wall facing south (-y world).
@@ -60,6 +62,7 @@ class Trajectory {
 
  private:
   RigState poseMotionAt(double t) const;  ///< camera motion of the pose scenarios (no mounting)
+  void finishPoses(const SimulationConfig& config);  ///< duration and remount time from poses_
 
   std::vector<StationaryPose> poses_;
   bool waving_ = false;
