@@ -23,12 +23,18 @@ namespace camera_imu_alignment {
 
 struct SceneFeatureSettings {
   int max_features = 1500;  ///< strongest SIFT keypoints kept per view
+  int octave_layers = 3;    ///< SIFT layers per octave (fewer: faster, fewer keypoints)
+  /// SIFT's contrast threshold (OpenCV's 0.04 / octave_layers scale): lower finds keypoints in
+  /// fainter texture (a plain wall, a table) at the cost of weaker ones.
+  double contrast_threshold = 0.04;
 };
 
 /// The features of one view (a rest's sharpest frame).
 struct SceneFeatures {
-  double stamp_s = 0;                     ///< the frame's stamp (camera clock, s)
-  std::vector<cv::KeyPoint> keypoints;    ///< pixels (distorted image)
+  double stamp_s = 0;  ///< the frame's stamp (camera clock, s)
+  /// Pixels of the (distorted) image, pixel centres at integer coordinates (OpenCV's SIFT
+  /// positions corrected for the quarter-pixel offset of its upsampled first octave).
+  std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;                    ///< one row per keypoint (CV_32F, SIFT)
   std::vector<Eigen::Vector3d> bearings;  ///< unit vectors, camera frame, one per keypoint
 };
@@ -51,6 +57,10 @@ struct SceneRotationSettings {
   double ratio_test = 0.8;  ///< Lowe's ratio of the best to the second-best descriptor distance
   /// Fewer inliers than this: no rotation (too little overlap, texture or a scene that moved).
   int min_inliers = 40;
+  /// RANSAC gate on a match's transfer / epipolar error (pixels of the undistorted image). It only
+  /// separates gross mismatches: the inliers are then re-selected at the chi-square 99.9 % bound of
+  /// the noise estimated from them, and the covariance's sigma comes from their residuals.
+  double ransac_threshold_px = 3.0;
   /// A gyro-predicted rotation further than this (deg) from the estimate fails the pair
   /// (a repetitive texture's wrong but consistent matches); 0: not checked.
   double max_prediction_difference_deg = 5.0;
@@ -65,9 +75,11 @@ struct SceneRotation {
   SceneMotionModel model = SceneMotionModel::kRotationOnly;
   /// kGeneral: the unit direction of the `to` camera centre in the `from` camera frame.
   Eigen::Vector3d translation_direction = Eigen::Vector3d::Zero();
-  int matches = 0;             ///< after the ratio test and the mutual check
-  int inliers = 0;             ///< of the chosen model
-  double residual_rms_px = 0;  ///< inliers' residual under the chosen model (pixels)
+  int matches = 0;  ///< after the ratio test and the mutual check
+  int inliers = 0;  ///< of the chosen model
+  /// The inliers' noise per image coordinate under the chosen model (pixels): the RMS of their
+  /// first-order geometric distances over the degrees of freedom; the sigma of cov_rad2.
+  double residual_rms_px = 0;
 };
 
 /// The rotation between two views. `R_from_to_prediction` (e.g. the gyro's, through the current
