@@ -138,24 +138,25 @@ Eigen::MatrixXd jacobian(const BearingMatches& m, const State& s, const std::vec
 }
 
 /// Levenberg-Marquardt on the sum of squared residuals of the matches `idx`; stops when the step
-/// is negligible (1e-10 rad) or the cost no longer decreases at small damping.
+/// is negligible (1e-9 rad) or the cost decreases by less than 1e-8 of itself (a pure rotation
+/// leaves the general model's translation flat: it would otherwise iterate to the limit).
 State refine(const BearingMatches& m, State s, const std::vector<int>& idx, bool general,
              const Weights& weights = Weights()) {
   VectorXd r = residuals(m, s, idx, general, weights);
   double cost = r.squaredNorm();
   double lambda = 1e-6;
-  for (int iteration = 0; iteration < 50; ++iteration) {
+  for (int iteration = 0; iteration < 20; ++iteration) {
     const Eigen::MatrixXd J = jacobian(m, s, idx, general, weights);
     Eigen::MatrixXd H = J.transpose() * J;
     const VectorXd g = J.transpose() * r;
     H.diagonal() *= 1 + lambda;
     const VectorXd step = -H.ldlt().solve(g);
-    if (!step.allFinite() || step.norm() < 1e-10) break;
+    if (!step.allFinite() || step.norm() < 1e-9) break;
     const State candidate = perturb(s, step);
     const VectorXd candidate_r = residuals(m, candidate, idx, general, weights);
     const double candidate_cost = candidate_r.squaredNorm();
     if (std::isfinite(candidate_cost) && candidate_cost <= cost) {
-      const bool converged = lambda < 1e-3 && cost - candidate_cost <= 1e-12 * cost;
+      const bool converged = cost - candidate_cost <= 1e-8 * cost;
       s = candidate;
       r = candidate_r;
       cost = candidate_cost;
@@ -212,14 +213,18 @@ std::vector<int> selectInliers(const BearingMatches& m, const State& s, double t
 /// the gate let in cannot bend the model towards itself, as it can in plain least squares, most of
 /// all the general model's translation near the epipole), then the inliers at the robust estimate
 /// (selectInliers), their least-squares fit and the covariance from their residuals over their
-/// degrees of freedom.
+/// degrees of freedom. `screen`: the final inliers are also screened for mismatches (cheirality
+/// for the general model, leave-one-out of high-leverage matches); off for the general model's
+/// fit for GRIC only, where under a pure rotation the translation is arbitrary and the screens
+/// would cost time and bias the choice.
 ModelFit refineAndSelect(const BearingMatches& m, State s, double threshold_px, bool general,
-                         bool cheirality) {
+                         bool screen) {
   ModelFit fit;
   const int codim = general ? 1 : 2, params = general ? 5 : 3;
   fit.codimension = codim;
   std::vector<int> idx;
-  for (int round = 0; round < kRefinementRounds; ++round) {
+  // Fewer robust rounds when the fit only serves the model choice.
+  for (int round = 0; round < (screen ? kRefinementRounds : 2); ++round) {
     double sigma2 = 0;
     selectInliers(m, s, threshold_px, general, false, &sigma2);
     idx.clear();
@@ -239,9 +244,10 @@ ModelFit refineAndSelect(const BearingMatches& m, State s, double threshold_px, 
   // fitted without it (an exact leave-one-out: the model is not linear enough for r / (1 - h)).
   for (int pass = 0; pass < 3; ++pass) {
     double sigma2 = 0;
-    idx = selectInliers(m, s, threshold_px, general, cheirality, &sigma2);
+    idx = selectInliers(m, s, threshold_px, general, general && screen, &sigma2);
     if (static_cast<int>(idx.size()) * codim <= params + 1) return fit;
     s = refine(m, s, idx, general);
+    if (!screen) break;
     const Eigen::MatrixXd J = jacobian(m, s, idx, general);
     const Eigen::MatrixXd A = (J.transpose() * J).inverse();
     const double leverage_gate = std::max(kLeverageGate, 3.0 * params / idx.size());
@@ -353,10 +359,10 @@ ModelFit fitRotationOnly(const BearingMatches& m, double threshold_px,
   if (best.size() < 5) return ModelFit();
   State s;
   s.R = R_best;
-  return refineAndSelect(m, s, threshold_px, false, false);
+  return refineAndSelect(m, s, threshold_px, false, true);
 }
 
-ModelFit fitGeneral(const BearingMatches& m, double threshold_px, bool cheirality) {
+ModelFit fitGeneral(const BearingMatches& m, double threshold_px, bool screen) {
   const int n = static_cast<int>(m.from.size());
   if (n < 6) return ModelFit();
   std::vector<cv::Point2d> to, from;
@@ -382,7 +388,7 @@ ModelFit fitGeneral(const BearingMatches& m, double threshold_px, bool cheiralit
   }
   s.R = projectToSO3(s.R);
   s.t.normalize();
-  return refineAndSelect(m, s, threshold_px, true, cheirality);
+  return refineAndSelect(m, s, threshold_px, true, screen);
 }
 
 double gric(const ModelFit& fit, const std::vector<bool>& counted, double sigma_px,

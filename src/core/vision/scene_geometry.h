@@ -46,10 +46,11 @@ ModelFit fitRotationOnly(const BearingMatches& matches, double threshold_px,
 
 /// Rotation and translation: OpenCV's 5-point RANSAC and cheirality, then refinement over the
 /// rotation and the translation direction; the rotation's covariance marginalises the
-/// translation (Schur complement). With `cheirality`, the final inliers must also triangulate in
-/// front of both cameras: for the chosen model only (under a pure rotation the translation is
-/// arbitrary and so is the test, which would bias the model choice).
-ModelFit fitGeneral(const BearingMatches& matches, double threshold_px, bool cheirality);
+/// translation (Schur complement). With `screen`, the final inliers must also triangulate in
+/// front of both cameras and pass a leave-one-out test when their leverage is high: for the
+/// chosen model only (under a pure rotation the translation is arbitrary and so are the screens,
+/// which would cost time and bias the model choice).
+ModelFit fitGeneral(const BearingMatches& matches, double threshold_px, bool screen);
 
 /// Torr's GRIC of a fit (lower is better) over the matches flagged in `counted`, with the
 /// common noise `sigma_px`: sum of min(d^2 / sigma^2, 2 codim) + n d ln 4 + k ln 4n, where
