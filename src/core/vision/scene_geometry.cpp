@@ -76,9 +76,9 @@ Vector2d rotationResidual(const State& s, const Vector3d& a, const Vector3d& b, 
 }
 
 /// General-model distance of one match: the Sampson distance to the epipolar constraint
-/// x_from^T [t]x R x_to = 0 (pixels).
-double sampsonResidual(const State& s, const Vector3d& a, const Vector3d& b, double fx, double fy) {
-  const Matrix3d E = skew(s.t) * s.R;
+/// x_from^T E x_to = 0 with E = [t]x R (pixels).
+double sampsonResidual(const Matrix3d& E, const Vector3d& a, const Vector3d& b, double fx,
+                       double fy) {
   const Vector3d xa = a / a.z(), xb = b / b.z();
   const Vector3d Eb = E * xb, Ea = E.transpose() * xa;
   const double g2 = std::pow(Eb.x() / fx, 2) + std::pow(Eb.y() / fy, 2) + std::pow(Ea.x() / fx, 2) +
@@ -105,10 +105,11 @@ bool inFrontOfBoth(const State& s, const Vector3d& a, const Vector3d& b) {
 VectorXd residuals(const BearingMatches& m, const State& s, const std::vector<int>& idx,
                    bool general, const Weights& weights = Weights()) {
   VectorXd r(idx.size() * (general ? 1 : 2));
+  const Matrix3d E = skew(s.t) * s.R;
   for (size_t k = 0; k < idx.size(); ++k) {
     const int i = idx[k];
     if (general) {
-      r(k) = sampsonResidual(s, m.from[i], m.to[i], m.fx, m.fy);
+      r(k) = sampsonResidual(E, m.from[i], m.to[i], m.fx, m.fy);
     } else {
       r.segment<2>(2 * k) = rotationResidual(s, m.from[i], m.to[i], m.fx, m.fy);
     }
@@ -173,8 +174,9 @@ State refine(const BearingMatches& m, State s, const std::vector<int>& idx, bool
 /// Squared distances of every match (px^2; the residual's squared norm).
 std::vector<double> distances2(const BearingMatches& m, const State& s, bool general) {
   std::vector<double> d2(m.from.size());
+  const Matrix3d E = skew(s.t) * s.R;
   for (size_t i = 0; i < d2.size(); ++i) {
-    d2[i] = general ? std::pow(sampsonResidual(s, m.from[i], m.to[i], m.fx, m.fy), 2)
+    d2[i] = general ? std::pow(sampsonResidual(E, m.from[i], m.to[i], m.fx, m.fy), 2)
                     : rotationResidual(s, m.from[i], m.to[i], m.fx, m.fy).squaredNorm();
   }
   return d2;
@@ -260,7 +262,9 @@ ModelFit refineAndSelect(const BearingMatches& m, State s, double threshold_px, 
       const State without = refine(m, s, others, general);
       const double d2 =
           general
-              ? std::pow(sampsonResidual(without, m.from[idx[k]], m.to[idx[k]], m.fx, m.fy), 2)
+              ? std::pow(sampsonResidual(skew(without.t) * without.R, m.from[idx[k]], m.to[idx[k]],
+                                         m.fx, m.fy),
+                         2)
               : rotationResidual(without, m.from[idx[k]], m.to[idx[k]], m.fx, m.fy).squaredNorm();
       if (d2 >= kChi2Bound999[codim] * sigma2) rejected.push_back(idx[k]);
     }
