@@ -24,12 +24,13 @@ namespace camera_imu_alignment {
 struct SceneFeatureSettings {
   int max_features = 1500;  ///< strongest SIFT keypoints kept per view
   int octave_layers = 3;    ///< SIFT layers per octave (fewer: faster, fewer keypoints)
-  /// SIFT's contrast threshold (OpenCV's 0.04 / octave_layers scale): lower finds keypoints in
-  /// fainter texture (a plain wall, a table) at the cost of weaker ones.
+  /// SIFT's contrast threshold (OpenCV's default; OpenCV divides it by octave_layers): lower finds
+  /// keypoints in fainter texture (a plain wall, a table), weaker ones.
   double contrast_threshold = 0.04;
   /// The image is resized by this factor (0 < image_scale <= 1, area averaging) before SIFT;
-  /// keypoints and bearings are in the full image's pixels. 0.5 costs about a quarter of the time
-  /// (SIFT's first octave works at twice the resolution it is given) and drops the finest scale.
+  /// keypoints and bearings are in the full image's pixels. 0.5 costs about half the time (SIFT's
+  /// first octave works at twice the resolution it is given), drops the finest scale and doubles
+  /// the rotation's error (still honest: BENCHMARKS.md, "Natural-scene rotation").
   double image_scale = 1.0;
 };
 
@@ -87,7 +88,12 @@ struct SceneRotation {
 };
 
 /// The rotation between two views. `R_from_to_prediction` (e.g. the gyro's, through the current
-/// R_cam_imu) seeds the refinement and checks the result (SceneRotationSettings); it may be absent.
+/// R_cam_imu) seeds the refinement (one more hypothesis of the rotation-only RANSAC) and checks the
+/// result (SceneRotationSettings); it may be absent. ok = false with a message naming the counts
+/// (features and stamps of both views, matches, inliers) when the features, matches or inliers are
+/// too few; a result too far from the prediction is ok = false with its rotation, model and counts
+/// filled in. Deterministic: the same features give the same result. The method: doc/method.md,
+/// "The camera's rotation from the natural scene".
 SceneRotation estimateSceneRotation(const SceneFeatures& from, const SceneFeatures& to,
                                     const CameraIntrinsics& intrinsics,
                                     const std::optional<Eigen::Matrix3d>& R_from_to_prediction,
