@@ -23,12 +23,23 @@ namespace camera_imu_alignment {
 
 struct SceneFeatureSettings {
   int max_features = 1500;  ///< strongest SIFT keypoints kept per view
+  int octave_layers = 3;    ///< SIFT layers per octave (fewer: faster, fewer keypoints)
+  /// SIFT's contrast threshold (OpenCV's default; OpenCV divides it by octave_layers): lower finds
+  /// keypoints in fainter texture (a plain wall, a table), weaker ones.
+  double contrast_threshold = 0.04;
+  /// The image is resized by this factor (0 < image_scale <= 1, area averaging) before SIFT;
+  /// keypoints and bearings are in the full image's pixels. 0.5 costs about half the time (SIFT's
+  /// first octave works at twice the resolution it is given), drops the finest scale and doubles
+  /// the rotation's error (still honest: BENCHMARKS.md, "Natural-scene rotation").
+  double image_scale = 1.0;
 };
 
 /// The features of one view (a rest's sharpest frame).
 struct SceneFeatures {
-  double stamp_s = 0;                     ///< the frame's stamp (camera clock, s)
-  std::vector<cv::KeyPoint> keypoints;    ///< pixels (distorted image)
+  double stamp_s = 0;  ///< the frame's stamp (camera clock, s)
+  /// Pixels of the (distorted) image, pixel centres at integer coordinates (OpenCV's SIFT
+  /// positions corrected for the quarter-pixel offset of its upsampled first octave).
+  std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;                    ///< one row per keypoint (CV_32F, SIFT)
   std::vector<Eigen::Vector3d> bearings;  ///< unit vectors, camera frame, one per keypoint
 };
@@ -51,6 +62,10 @@ struct SceneRotationSettings {
   double ratio_test = 0.8;  ///< Lowe's ratio of the best to the second-best descriptor distance
   /// Fewer inliers than this: no rotation (too little overlap, texture or a scene that moved).
   int min_inliers = 40;
+  /// RANSAC gate on a match's transfer / epipolar error (pixels of the undistorted image). It only
+  /// separates gross mismatches: the inliers are then re-selected at the chi-square 99.9 % bound of
+  /// the noise estimated from them, and the covariance's sigma comes from their residuals.
+  double ransac_threshold_px = 3.0;
   /// A gyro-predicted rotation further than this (deg) from the estimate fails the pair
   /// (a repetitive texture's wrong but consistent matches); 0: not checked.
   double max_prediction_difference_deg = 5.0;
@@ -65,13 +80,20 @@ struct SceneRotation {
   SceneMotionModel model = SceneMotionModel::kRotationOnly;
   /// kGeneral: the unit direction of the `to` camera centre in the `from` camera frame.
   Eigen::Vector3d translation_direction = Eigen::Vector3d::Zero();
-  int matches = 0;             ///< after the ratio test and the mutual check
-  int inliers = 0;             ///< of the chosen model
-  double residual_rms_px = 0;  ///< inliers' residual under the chosen model (pixels)
+  int matches = 0;  ///< after the ratio test and the mutual check
+  int inliers = 0;  ///< of the chosen model
+  /// The inliers' noise per image coordinate under the chosen model (pixels): the RMS of their
+  /// first-order geometric distances over the degrees of freedom; the sigma of cov_rad2.
+  double residual_rms_px = 0;
 };
 
 /// The rotation between two views. `R_from_to_prediction` (e.g. the gyro's, through the current
-/// R_cam_imu) seeds the refinement and checks the result (SceneRotationSettings); it may be absent.
+/// R_cam_imu) seeds the refinement (one more hypothesis of the rotation-only RANSAC) and checks the
+/// result (SceneRotationSettings); it may be absent. ok = false with a message naming the counts
+/// (features and stamps of both views, matches, inliers) when the features, matches or inliers are
+/// too few; a result too far from the prediction is ok = false with its rotation, model and counts
+/// filled in. Deterministic: the same features give the same result. The method: doc/method.md,
+/// "The camera's rotation from the natural scene".
 SceneRotation estimateSceneRotation(const SceneFeatures& from, const SceneFeatures& to,
                                     const CameraIntrinsics& intrinsics,
                                     const std::optional<Eigen::Matrix3d>& R_from_to_prediction,
