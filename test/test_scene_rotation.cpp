@@ -140,6 +140,44 @@ TEST(SceneRotation, AnalyticBearingsRecoverRotationModelAndHonestCovariance) {
   }
 }
 
+// Known limitation, measured, not asserted (run with --gtest_also_run_disabled_tests): baselines of
+// 0.5-10 cm at 2-5 m depth. There a translation shifts every point by about |t| / depth, which the
+// rotation-only model takes for a rotation and GRIC cannot tell apart until the depth spread makes
+// the parallax uneven; the general model, chosen from about 2 cm, marginalises a translation
+// direction its data barely determine. Measured (50 seeds each, 300 points, 30 % outliers):
+//   baseline   general chosen   mean normalised error (rotation-only / general)   max error
+//   0.5 cm      0/50            167 / -                                           0.09 deg
+//   1 cm        2/50            575 / 81                                          0.17 deg
+//   2 cm       12/50            1690 / 228                                        0.34 deg
+//   5 cm       38/50            4443 / 14.7                                       0.78 deg
+//   10 cm      50/50            - / 9.4                                           0.30 deg
+// (0 and 50 cm: honest, the test above.) A hand-held rig moves this much between rests.
+TEST(SceneRotation, DISABLED_SmallBaselinesMeasured) {
+  const CameraIntrinsics intrinsics = syntheticIntrinsics();
+  for (double baseline_m : {0.005, 0.01, 0.02, 0.05, 0.1}) {
+    double sum_nees[2] = {0, 0}, max_error_deg = 0;
+    int count[2] = {0, 0};
+    for (int seed = 0; seed < 50; ++seed) {
+      std::mt19937_64 rng(5000 + seed);
+      const Eigen::Matrix3d R_from_to = test::axisAngle(test::randomUnitVector(rng), 0.15);
+      const Eigen::Vector3d t_from = baseline_m * test::randomUnitVector(rng);
+      const AnalyticViews v = analyticViews(rng, R_from_to, t_from, 0.3, 300);
+      const SceneRotation r =
+          estimateSceneRotation(v.from, v.to, intrinsics, std::nullopt, SceneRotationSettings());
+      if (!r.ok) continue;
+      const int k = r.model == SceneMotionModel::kGeneral;
+      sum_nees[k] += normalisedError(r, R_from_to);
+      ++count[k];
+      max_error_deg = std::max(max_error_deg, errorDeg(r, R_from_to));
+    }
+    std::printf(
+        "baseline %.3f m: general chosen %d/%d, mean normalised error %.1f / %.1f "
+        "(rotation-only / general), max error %.3f deg\n",
+        baseline_m, count[1], count[0] + count[1], count[0] ? sum_nees[0] / count[0] : 0.0,
+        count[1] ? sum_nees[1] / count[1] : 0.0, max_error_deg);
+  }
+}
+
 // Views of the texture at infinity: the pure rotation R_from_to between two orientations.
 struct RenderedPair {
   cv::Mat from, to;
