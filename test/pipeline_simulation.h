@@ -7,12 +7,15 @@
 #include <algorithm>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <random>
 #include <vector>
 
 #include "camera_imu_alignment/online/online_calibrator.h"
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
 #include "camera_imu_alignment/simulation/renderer.h"
+#include "camera_imu_alignment/simulation/room_scene.h"
+#include "camera_imu_alignment/simulation/scene_renderer.h"
 #include "camera_imu_alignment/simulation/simulation_run.h"
 #include "camera_imu_alignment/simulation/target.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
@@ -120,12 +123,31 @@ inline Injected feedRenderedRun(const simulation::SimulationRun& run, SampleSink
       }
     }
   };
+  // The room scenarios (no board): the room at rest; no frame while moving (without a target the
+  // pipeline uses frames at rest only).
+  const bool room = sim::isRoomMotion(c.motion);
+  std::optional<sim::SceneRenderer> room_renderer;
+  if (room) {
+    room_renderer.emplace(sim::CameraModel::fromConfig(c), sim::RoomScene::fromConfig(c),
+                          c.supersample, c.blur_sigma_px);
+  }
   int cached_pose = -1;
   cv::Mat cached;
   for (std::size_t j = 0; j < run.frame_times.size(); ++j) {
     const double t = run.frame_times[j];
     const double stamp = t + c.camera_time_offset_s;
     feedInertialUpTo(stamp);
+    if (room) {
+      const int pose = run.trajectory.at(t).pose;
+      if (pose < 0) continue;
+      if (pose != cached_pose || c.moving_objects)
+        cached = room_renderer->renderAt(run.trajectory, t);
+      cached_pose = pose;
+      sink->addFrame(
+          {stamp, sim::ImageRenderer::toMono8(cached, c.noise_scale * c.pixel_noise_sigma,
+                                              run.frameNoiseSeed(static_cast<long>(j)))});
+      continue;
+    }
     if (every(j, injection.empty_frame_every)) {
       sink->addFrame({stamp, cv::Mat()});
       ++injected.empty_frames;
@@ -153,6 +175,7 @@ inline Injected feedRenderedRun(const simulation::SimulationRun& run, SampleSink
 }
 
 inline TargetDescription simulatedTarget(const simulation::SimulationConfig& c) {
+  if (simulation::isRoomMotion(c.motion)) return TargetDescription{};  // no board: natural scene
   return parseTargetYaml(simulation::targetYaml(c.target), "simulated target");
 }
 

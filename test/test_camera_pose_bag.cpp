@@ -147,10 +147,12 @@ TEST(CameraPoseBag, CameraSourceIsChosenAndSaid) {
                                    "--num-poses 2 --hold-min-s 1 --hold-max-s 1 "
                                    "--width 64 --height 48 --camera-pose");
   const std::string stem = test::bagStem(bag);
-  // Default: the images, which need the target; the note names the camera_pose topic.
+  // Default: the images, without a target the natural scene's features (64x48 frames of a board
+  // have too few: no pose); the note names the camera_pose topic.
   test::ToolRun run = test::runTool(kCalibrate + " --quiet --bag " + bag);
-  EXPECT_EQ(run.exit_code, 2);
-  EXPECT_NE(run.err.find("--target is required"), std::string::npos) << run.err;
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.err.find("no --target: the natural scene's features"), std::string::npos)
+      << run.err;
   EXPECT_NE(run.err.find("camera source: images on /camera/image_raw; the bag also has camera "
                          "poses on /camera_pose, not read"),
             std::string::npos)

@@ -144,14 +144,15 @@ TEST(PipelineConfig, DocumentedDefaultsEqualTheBuiltInOnes) {
   EXPECT_EQ(online.remount_poses, online_defaults.remount_poses);
   EXPECT_EQ(online.remount_residual_deg, online_defaults.remount_residual_deg);
   EXPECT_EQ(online.manual_capture, online_defaults.manual_capture);
-  // The wrapper's section too (target_file is required and has no default).
+  // The wrapper's section too (target_file empty: the natural scene).
   std::ifstream in(configPath());
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   WrapperSettings w;
   w.status_period_s = 7;
   w.publish_inverse = true, w.load_on_start = false;
   PipelineSettings p;
-  EXPECT_THROW(parseSettings(text, "default.yaml", &w, &p), InputError);  // target_file: ""
+  ASSERT_NO_THROW(parseSettings(text, "default.yaml", &w, &p));  // target_file: "", no board
+  EXPECT_TRUE(w.target_file.empty());
   ASSERT_NO_THROW(parseSettings(text + "target_file: t.yaml\n", "default.yaml", &w, &p));
   const WrapperSettings d;
   EXPECT_EQ(w.status_period_s, d.status_period_s);

@@ -199,14 +199,15 @@ TEST(SettingsError, EveryBadSettingIsOneTypeNamingSourceAndKey) {
     EXPECT_EQ(std::string(e.what()), "frame_queue_s = -1: must be a finite number > 0");
   }
   EXPECT_THROW({ CalibrationPipeline refused(target, bad); }, std::invalid_argument);
-  // A wrong type, an unknown key, a missing required parameter.
+  // A wrong type, an unknown key; no target_file is no error (the natural scene).
   WrapperSettings w;
   PipelineSettings p;
   EXPECT_THROW(parseSettings("target_file: t.yaml\nmin_poses: many\n", "params", &w, &p),
                SettingsError);
   EXPECT_THROW(parseSettings("target_file: t.yaml\nmin_pose: 3\n", "params", &w, &p),
                SettingsError);
-  EXPECT_THROW(parseSettings("camera_frame: c\n", "params", &w, &p), SettingsError);
+  EXPECT_NO_THROW(parseSettings("camera_frame: c\n", "params", &w, &p));
+  EXPECT_TRUE(w.target_file.empty());
 }
 
 TEST(SettingsTypo, AnUnknownKeyIsAnsweredWithTheClosestKnownKey) {

@@ -28,89 +28,16 @@
 #include "camera_imu_alignment/solver/rotation_math.h"
 
 #include "visp_data.h"
+#include "visp_recording.h"
 
 namespace camera_imu_alignment {
 namespace {
 
 const std::string kDir = test::vispDir();
-constexpr int kPoses = 8;
-constexpr double kRestS = 4.0, kMoveS = 3.0, kImuRateHz = 200.0, kFrameRateHz = 5.0;
-constexpr double kGravity = 9.81;
-
-struct VispRecording {
-  std::vector<Eigen::Matrix3d> R_world_imu;
-  std::vector<cv::Mat> images;
-};
-
-bool loadRecording(VispRecording* out) {
-  for (int i = 1; i <= kPoses; ++i) {
-    Eigen::Matrix3d R;
-    if (!test::readVispFlangeRotation(kDir + "/franka_pose_rPe_" + std::to_string(i) + ".yaml",
-                                      &R)) {
-      return false;
-    }
-    const cv::Mat image =
-        cv::imread(kDir + "/franka_image-" + std::to_string(i) + ".png", cv::IMREAD_GRAYSCALE);
-    if (image.empty()) return false;
-    out->R_world_imu.push_back(R);
-    out->images.push_back(image);
-  }
-  return true;
-}
-
-/// Feeds the recording to `pipeline`: IMU samples (gyro = w + b_g + n, accel = R^T (0, 0, g) +
-/// b_a + n) and, at rest, the real image with fresh noise.
-void feed(const VispRecording& rec, CalibrationPipeline* pipeline) {
-  std::mt19937 rng(23);
-  std::normal_distribution<double> normal(0.0, 1.0);
-  const double gyro_sigma = 2.6e-4 * std::sqrt(kImuRateHz);    // consumer datasheet density
-  const double accel_sigma = 2.26e-3 * std::sqrt(kImuRateHz);  // per sample
-  const Eigen::Vector3d gyro_bias(0.004, -0.006, 0.003), accel_bias(0.04, -0.03, 0.05);
-  const Eigen::Vector3d specific_force_world(0.0, 0.0, kGravity);
-  auto noise = [&](double sigma) {
-    return Eigen::Vector3d(sigma * normal(rng), sigma * normal(rng), sigma * normal(rng));
-  };
-  const double start = 100.0;
-  double t = start;
-  const double dt = 1.0 / kImuRateHz;
-  double next_frame = t;
-  for (int k = 0; k < kPoses; ++k) {
-    const double rest_end = t + kRestS;
-    for (; t < rest_end; t += dt) {
-      const Eigen::Matrix3d& R = rec.R_world_imu[k];
-      pipeline->addImu({t, gyro_bias + noise(gyro_sigma),
-                        R.transpose() * specific_force_world + accel_bias + noise(accel_sigma)});
-      if (t >= next_frame && t > rest_end - kRestS + 0.3 && t < rest_end - 0.3) {
-        cv::Mat noisy;
-        rec.images[k].convertTo(noisy, CV_32F);
-        cv::Mat sensor(noisy.size(), CV_32F);
-        cv::randn(sensor, 0.0, 1.5);
-        noisy += sensor;
-        cv::Mat frame;
-        noisy.convertTo(frame, CV_8U);
-        CameraFrame camera_frame;
-        camera_frame.stamp_s = t;
-        camera_frame.mono8 = frame;
-        pipeline->addFrame(camera_frame);
-        next_frame = t + 1.0 / kFrameRateHz;
-      }
-    }
-    if (k + 1 == kPoses) break;
-    const Eigen::Matrix3d& Ra = rec.R_world_imu[k];
-    const Eigen::Vector3d phi = logSO3(Ra.transpose() * rec.R_world_imu[k + 1]);
-    const double move_start = t;
-    for (; t < move_start + kMoveS; t += dt) {
-      double f, df, ddf;
-      simulation::minimumJerk((t - move_start) / kMoveS, &f, &df, &ddf);
-      const Eigen::Matrix3d R = Ra * expSO3(f * phi);
-      const Eigen::Vector3d omega_imu = (df / kMoveS) * phi;  // body rate (phi is a body axis)
-      pipeline->addImu({t, omega_imu + gyro_bias + noise(gyro_sigma),
-                        R.transpose() * specific_force_world + accel_bias + noise(accel_sigma)});
-    }
-    next_frame = t;
-  }
-  pipeline->finish();
-}
+using test::feedVispRecording;
+using test::kVispPoses;
+using test::loadVispRecording;
+using test::VispRecording;
 
 /// The first `count` poses of `problem` and the gyro segments between them.
 JointProblem firstPoses(const JointProblem& problem, size_t count) {
@@ -134,7 +61,7 @@ struct VispOutcome {
 /// change test after each new pose, as the online calibrator runs it.
 bool runVisp(VispOutcome* out) {
   VispRecording rec;
-  if (!loadRecording(&rec)) return false;
+  if (!loadVispRecording(kDir, &rec)) return false;
   const TargetDescription board = test::vispBoard();
   CameraIntrinsics intrinsics;
   std::string error;
@@ -142,8 +69,8 @@ bool runVisp(VispOutcome* out) {
   const PipelineSettings settings;
   CalibrationPipeline pipeline(board, settings);
   EXPECT_TRUE(pipeline.setCameraIntrinsics(intrinsics));
-  feed(rec, &pipeline);
-  EXPECT_EQ(pipeline.poses().size(), static_cast<size_t>(kPoses));
+  feedVispRecording(rec, &pipeline);
+  EXPECT_EQ(pipeline.poses().size(), static_cast<size_t>(kVispPoses));
   for (const StationaryPose& pose : pipeline.poses()) {
     std::printf("pose %d: %d frames, reprojection %.2f px, camera spread %.4f deg\n", pose.index,
                 pose.num_frames, pose.reprojection_rms_px, pose.camera_spread_deg);

@@ -243,7 +243,8 @@ void AlignmentWrapper::Impl::publishDebugImage(const cv::Mat& mono8,
   if ((now - last_debug).toSec() < 0.2) return;
   last_debug = now;
   TargetObservation observation;
-  const bool found = debug_detector->detect(mono8, &observation);
+  const bool natural_scene = settings.target_file.empty();  // no board to look for
+  const bool found = !natural_scene && debug_detector->detect(mono8, &observation);
   cv::Mat bgr;
   cv::cvtColor(mono8, bgr, cv::COLOR_GRAY2BGR);
   for (std::size_t i = 0; i < observation.image_points.size(); ++i) {
@@ -251,8 +252,9 @@ void AlignmentWrapper::Impl::publishDebugImage(const cv::Mat& mono8,
                                                             : cv::Scalar(0, 255, 0);
     cv::circle(bgr, observation.image_points[i], 3, colour, 1, cv::LINE_AA);
   }
-  const std::string text =
-      found ? std::to_string(observation.image_points.size()) + " points" : "target not found";
+  const std::string text = natural_scene ? "natural scene (no target)"
+                           : found ? std::to_string(observation.image_points.size()) + " points"
+                                   : "target not found";
   cv::putText(bgr, text, cv::Point(10, 25), cv::FONT_HERSHEY_SIMPLEX, 0.7,
               found ? cv::Scalar(0, 255, 0) : cv::Scalar(0, 0, 255), 2, cv::LINE_AA);
   sensor_msgs::Image out;

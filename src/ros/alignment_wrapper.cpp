@@ -31,7 +31,9 @@ AlignmentWrapper::Impl::Impl(ros::NodeHandle nh_, ros::NodeHandle private_nh)
   for (const std::string& notice : resolvePaths(&settings)) {
     ROS_WARN("%s: %s", name.c_str(), notice.c_str());
   }
-  const TargetDescription target = loadTargetYaml(settings.target_file);
+  // No target_file: no board, the camera's rotation from the natural scene.
+  const TargetDescription target =
+      settings.target_file.empty() ? TargetDescription{} : loadTargetYaml(settings.target_file);
   OnlineCallbacks callbacks;
   callbacks.on_pose = [this](const StationaryPose& p) { onPose(p); };
   callbacks.on_pose_rejected = [this](const RejectedPose& r) { onPoseRejected(r); };
@@ -53,7 +55,12 @@ AlignmentWrapper::Impl::Impl(ros::NodeHandle nh_, ros::NodeHandle private_nh)
   });
   input->setTopicNames([this](InputStream stream) { return topicOf(stream); });
   debug_detector = std::make_unique<TargetDetector>(target, pipeline_settings.detector);
-  ROS_INFO_STREAM(name << ": target " << target.describe() << " from " << settings.target_file);
+  if (settings.target_file.empty()) {
+    ROS_INFO_STREAM(name << ": no target_file: the camera's rotation between rests from the "
+                            "natural scene (features)");
+  } else {
+    ROS_INFO_STREAM(name << ": target " << target.describe() << " from " << settings.target_file);
+  }
 
   advertise();
   if (settings.load_on_start) loadSaved();

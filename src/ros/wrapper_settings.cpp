@@ -22,8 +22,9 @@ using Key = SettingKey<WrapperSettings>;
 const std::vector<Key>& keys() {
   const char* const frame = "a tf frame name (text), or empty";
   static const std::vector<Key> table = {
-      textKey<WrapperSettings>("target_file", CIA_MEMBER(target_file), "a file path (text)",
-                               "Kalibr target YAML; required"),
+      textKey<WrapperSettings>(
+          "target_file", CIA_MEMBER(target_file), "a file path (text)",
+          "Kalibr target YAML; empty: no board, the camera's rotation from the natural scene"),
       textKey<WrapperSettings>("camera_frame", CIA_MEMBER(camera_frame), frame,
                                "tf frame of the camera; empty: the image header's frame_id"),
       textKey<WrapperSettings>("imu_frame", CIA_MEMBER(imu_frame), frame,
@@ -66,12 +67,9 @@ YAML::Node toYaml(XmlRpc::XmlRpcValue& value, const std::string& name) {
   }
 }
 
-/// The wrapper's ranges, then its one rule: target_file is required.
+/// The wrapper's ranges (an empty target_file: the natural scene, no board).
 void check(const std::string& source, const WrapperSettings& s) {
   throwIfProblem(source, checkRanges(keys(), s));
-  if (s.target_file.empty()) {
-    throw SettingsError(source, "target_file", "target_file is required (a Kalibr target YAML)");
-  }
 }
 
 }  // namespace
@@ -91,14 +89,16 @@ std::vector<std::string> resolvePaths(WrapperSettings* settings) {
   const std::string target = expandHome(settings->target_file);
   std::error_code error;
   const fs::path target_abs = fs::absolute(target, error);
-  if (!fs::is_regular_file(target_abs, error)) {
-    const bool relative = fs::path(target).is_relative();
-    throw SettingsError("", "target_file",
-                        "target_file '" + settings->target_file + "': no such file: tried " +
-                            target_abs.string() +
-                            (relative ? "; " + where + ": give an absolute path" : ""));
+  if (!settings->target_file.empty()) {  // empty: no board, the natural scene
+    if (!fs::is_regular_file(target_abs, error)) {
+      const bool relative = fs::path(target).is_relative();
+      throw SettingsError("", "target_file",
+                          "target_file '" + settings->target_file + "': no such file: tried " +
+                              target_abs.string() +
+                              (relative ? "; " + where + ": give an absolute path" : ""));
+    }
+    settings->target_file = target_abs.string();
   }
-  settings->target_file = target_abs.string();
   if (!settings->output_file.empty()) {
     const std::string output = expandHome(settings->output_file);
     const std::string output_abs = fs::absolute(output, error).string();

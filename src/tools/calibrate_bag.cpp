@@ -59,8 +59,9 @@ const char* kUsage =
     "                        CompressedImage and CameraInfo (topics found by type when not "
     "given),\n"
     "                        or geometry_msgs/PoseStamped camera poses instead of the images\n"
-    "  --target TARGET.yaml  Kalibr target file (checkerboard, aprilgrid, circlegrid); required\n"
-    "                        with images, not with camera poses\n"
+    "  --target TARGET.yaml  Kalibr target file (checkerboard, aprilgrid, circlegrid). Without\n"
+    "                        it the camera's rotation between rests comes from the natural\n"
+    "                        scene (features matched between the rests' views)\n"
     "  --camera-pose-topic T camera poses (geometry_msgs/PoseStamped, the camera in the target\n"
     "                        frame) as the camera source, images not read. Default: a topic\n"
     "                        named camera_pose when the bag has no image topic\n"
@@ -200,15 +201,8 @@ int run(const cia::CliArgs& args) {
   if (!topics.camera_source_note.empty()) {
     std::cerr << "[calibrate_bag] " << topics.camera_source_note << "\n";
   }
-  if (!camera_poses && !args.has("--target")) {
-    if (topics.image.empty()) {
-      std::cerr << "calibrate_bag: " << bag_path << ": " << kNoCameraData << "\n";
-    } else {
-      std::cerr << "calibrate_bag: --target is required: the camera source is images on "
-                << topics.image
-                << ", and detecting the board needs its description (camera poses, "
-                   "geometry_msgs/PoseStamped on camera_pose or --camera-pose-topic, need none)\n";
-    }
+  if (!camera_poses && topics.image.empty()) {
+    std::cerr << "calibrate_bag: " << bag_path << ": " << kNoCameraData << "\n";
     return kExitBadInput;
   }
   std::cerr << "[calibrate_bag] " << bag_path << ": IMU " << topics.imu << ", magnetometer "
@@ -217,8 +211,10 @@ int run(const cia::CliArgs& args) {
     std::cerr << ", camera poses " << topics.camera_pose << " (no target or camera info needed)\n";
   } else {
     std::cerr << ", images " << (topics.image.empty() ? "(none)" : topics.image) << ", camera info "
-              << (topics.camera_info.empty() ? "(none)" : topics.camera_info) << "; target "
-              << target.describe() << "\n";
+              << (topics.camera_info.empty() ? "(none)" : topics.camera_info)
+              << (args.has("--target") ? "; target " + target.describe()
+                                       : "; no --target: the natural scene's features")
+              << "\n";
   }
 
   // --- Run the pipeline over the bag.

@@ -68,6 +68,7 @@
 #include "camera_imu_alignment/vision/camera_model.h"
 #include "camera_imu_alignment/vision/camera_model_check.h"
 #include "camera_imu_alignment/vision/camera_pose.h"
+#include "camera_imu_alignment/vision/scene_rotation.h"
 #include "camera_imu_alignment/vision/target_detector.h"
 
 namespace camera_imu_alignment {
@@ -102,6 +103,12 @@ struct PipelineSettings {
   double max_timeshift_s = 0.1;
   double frame_queue_s = 3.0;  ///< frames older than the IMU by more are dropped (no IMU)
   double accel_weight = 0.9;   ///< attitudeFromAccelMag
+  /// Without a target (an empty TargetDescription): the camera's rotation between rests from the
+  /// natural scene (vision/scene_rotation.h), features of each rest's sharpest frame. Not keys.
+  SceneFeatureSettings scene_features;
+  SceneRotationSettings scene_rotation;
+  /// A new rest is matched with at most this many earlier rests (newest first).
+  int max_scene_matches = 4;
   /// Returns an empty string when usable, else the first unusable setting, named by its key in
   /// config/default.yaml.
   std::string validate() const;
@@ -122,6 +129,25 @@ enum class PoseImuSource {
 /// "gyro", "accel_mag", "accel_only", "message".
 const char* toString(PoseImuSource source);
 
+/// Where a pose's camera orientation came from.
+enum class PoseCameraSource {
+  kTarget,  ///< the target (PnP) or given camera poses (camera_pose)
+  kScene    ///< the natural scene: features matched with earlier rests (no target)
+};
+/// "target", "scene".
+const char* toString(PoseCameraSource source);
+
+/// A natural-scene rotation measured between a pose and an earlier one (vision/scene_rotation.h).
+struct SceneLinkSummary {
+  int from_pose = 0;  ///< StationaryPose::index of the earlier pose
+  int matches = 0, inliers = 0;
+  SceneMotionModel model = SceneMotionModel::kRotationOnly;
+  double residual_rms_px = 0.0;
+  double sigma_deg = 0.0;  ///< RMS 1-sigma per axis of the measured rotation
+  /// The measured rotation (vision/scene_rotation.h: R_G_cam_this = R_G_cam_from R_from_to).
+  Eigen::Matrix3d R_from_to = Eigen::Matrix3d::Identity();
+};
+
 /// A stationary pose as the pipeline assembled it.
 struct StationaryPose {
   int index = 0;  ///< 0-based, in order of the recording
@@ -136,6 +162,14 @@ struct StationaryPose {
   /// Mean over the frames of their PnP orientation covariance (CameraPose::cov_rotation_rad2;
   /// rad^2, camera axes): the reprojection residuals beyond what the frames' scatter shows.
   Eigen::Matrix3d camera_pnp_cov_rad2 = Eigen::Matrix3d::Zero();
+  PoseCameraSource camera_source = PoseCameraSource::kTarget;
+  /// Natural scene: R_target_cam is the camera in the frame of scene `scene` (its first rest's
+  /// camera frame; a rest whose view overlaps none in the window starts the next scene), chained
+  /// through the strongest link; the links themselves enter the joint estimate.
+  int scene = 0;
+  int scene_features = 0;  ///< features in the rest's sharpest frame
+  std::vector<SceneLinkSummary> scene_links;
+  std::string scene_note;  ///< why the pose starts a new scene (its view overlaps no earlier one)
   // IMU.
   Eigen::Matrix3d R_world_imu = Eigen::Matrix3d::Identity();  ///< used for the pairs
   PoseImuSource imu_source = PoseImuSource::kGyro;            ///< where R_world_imu came from

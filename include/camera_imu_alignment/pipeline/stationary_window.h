@@ -22,6 +22,9 @@ class StationaryWindow {
     JointPose joint;      ///< the rest's measurements for the joint estimate
     /// Gyro samples from the previous pose's rest to this one's (same chain), if recorded.
     std::optional<GyroSegment> gyro_from_previous;
+    /// Natural scene: camera rotations measured from earlier poses to this one, from_pose and
+    /// to_pose being StationaryPose::index values (problem() maps them into the window).
+    std::vector<CameraLink> camera_links;
   };
 
   /// Keeps the newest `max_poses` (at least 2) entries: the mount may drift, old poses leave.
@@ -44,7 +47,7 @@ class StationaryWindow {
   /// All pairs (k, t), k < t, of one group (makeAllPairs of orientations()).
   RotationPairs pairs() const;
   /// The joint estimator's problem: a gyro segment is kept when its previous pose is in the window
-  /// and of the same group.
+  /// and of the same group, a camera link when both its poses are.
   JointProblem problem() const;
 
  private:

@@ -97,6 +97,9 @@ struct JointResult {
   /// Per pose: the magnetometer residual's squared whitened norm (chi-square with 3 dof when the
   /// model holds; robust loss not applied), 0 where the field is not used.
   std::vector<double> mag_residual_chi2;
+  /// Per JointProblem::camera_links entry: its residual's squared whitened norm (chi-square with 3
+  /// dof when the model holds; robust loss not applied).
+  std::vector<double> camera_link_chi2;
   /// Poses whose field was left out as disturbed: it did not fit the calibrated iron and field.
   std::vector<int> mag_poses_left_out;
   /// The camera-IMU time offset (Kalibr's timeshift_cam_imu: t_imu = t_cam + timeshift; s) and

@@ -16,6 +16,9 @@ struct PoseOrientation {
   /// Poses of different groups are never paired: their world (or target) frames are unrelated,
   /// e.g. IMU orientations from two gyro chains without a magnetometer heading between them.
   int group = 0;
+  /// Poses whose camera orientations are in different frames (two natural scenes whose views
+  /// never overlapped, pipeline/calibration_pipeline.h) are never paired either.
+  int camera_frame = 0;
 };
 
 /// Pair choice: every pair (k, t), k < t, of the same group. Each pose then informs the estimate

@@ -226,6 +226,7 @@ class Builder {
       record(
           ceres_.AddResidualBlock(cost, loss_, state_.delta[from].data(), state_.delta[to].data()),
           static_cast<int>(from), static_cast<int>(to), 3);
+      built_.residuals.back().camera_link = static_cast<int>(j);
     }
   }
 

@@ -75,6 +75,7 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
   int residual_count = 0;
   Eigen::VectorXd r(16);
   result->mag_residual_chi2.assign(n, 0.0);
+  result->camera_link_chi2.assign(problem.camera_links.size(), 0.0);
   for (const ResidualRecord& record : built.residuals) {
     double cost = 0.0;
     r.resize(record.size);
@@ -82,6 +83,7 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
     const double squared = r.squaredNorm();
     chi2 += squared;
     if (record.magnetometer && record.pose >= 0) result->mag_residual_chi2[record.pose] = squared;
+    if (record.camera_link >= 0) result->camera_link_chi2[record.camera_link] = squared;
     residual_count += record.size;
     if (record.pose < 0) continue;
     const double share = record.other_pose >= 0 ? 0.5 : 1.0;

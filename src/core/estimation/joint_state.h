@@ -66,6 +66,7 @@ struct ResidualRecord {
   int pose = -1, other_pose = -1;  ///< -1 for priors; other_pose for gyro and walk residuals
   int size = 0;
   bool magnetometer = false;  ///< the pose's magnetometer residual
+  int camera_link = -1;       ///< index into JointProblem::camera_links, or -1
 };
 
 /// The built problem's bookkeeping.

@@ -153,6 +153,29 @@ void writeQuality(std::ostream& out, const ReportInput& in) {
   if (in.result.joint) writeJoint(out, *in.result.joint);
 }
 
+/// The natural scene's poses (no target): features, and the links that measured each camera.
+void writeScenePoses(std::ostream& out, const ReportInput& in) {
+  bool any = false;
+  for (const StationaryPose& p : in.poses) any = any || p.camera_source == PoseCameraSource::kScene;
+  if (!any) return;
+  out << "camera from the natural scene (no target): per pose its features and the rotations "
+         "measured from earlier rests (matches, inliers, model, 1-sigma per axis):\n";
+  for (const StationaryPose& p : in.poses) {
+    if (p.camera_source != PoseCameraSource::kScene) continue;
+    out << "  pose " << std::setw(3) << p.index << "  scene " << p.scene << "  " << p.scene_features
+        << " features";
+    if (p.scene_links.empty()) out << "  no link";
+    for (const SceneLinkSummary& link : p.scene_links) {
+      out << "  | from pose " << link.from_pose << ": " << link.matches << " matches, "
+          << link.inliers << " inliers, "
+          << (link.model == SceneMotionModel::kGeneral ? "general" : "rotation-only") << ", "
+          << fixed(link.sigma_deg, 3) << " deg";
+    }
+    out << "\n";
+    if (!p.scene_note.empty()) out << "    " << p.scene_note << "\n";
+  }
+}
+
 void writePoses(std::ostream& out, const ReportInput& in) {
   out << "poses used: " << in.poses.size() << ", rests rejected: " << in.rejected.size()
       << ", IMU rests: " << in.segments.size() << "\n";
@@ -162,6 +185,7 @@ void writePoses(std::ostream& out, const ReportInput& in) {
         << " s (from start): " << (r.reason.empty() ? "(no reason given)" : r.reason) << "\n";
   }
   out << "inputs rejected: " << in.rejections.summary() << "\n";
+  writeScenePoses(out, in);
 }
 
 /// One line per pose: what the report's per-pose panel draws.

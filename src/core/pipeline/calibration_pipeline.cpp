@@ -41,6 +41,10 @@ const char* toString(PoseImuSource source) {
   return "unknown";
 }
 
+const char* toString(PoseCameraSource source) {
+  return source == PoseCameraSource::kScene ? "scene" : "target";
+}
+
 bool usesJointEstimate(ImuOrientationSource source) {
   return source == ImuOrientationSource::kJoint || source == ImuOrientationSource::kMagnetometer;
 }
@@ -81,6 +85,7 @@ CalibrationPipeline::Impl::Impl(const TargetDescription& target_, const Pipeline
       symmetries(detector.symmetries()),
       stationary(settings_.stationary),
       disturbance(settings_.disturbance),
+      natural_scene(target_.numPoints() == 0),
       window(settings_.window_poses) {}
 
 void CalibrationPipeline::Impl::reject(RejectReason reason, InputStream stream,
@@ -264,10 +269,15 @@ void CalibrationPipeline::Impl::processFrame(const CameraFrame& frame) {
   for (const auto& d : detections) in_this_rest += (rest_since && d.stamp_s >= *rest_since);
   if (in_this_rest >= settings.max_frames_per_pose) return;
   if (frame.R_target_cam) {  // given orientation: nothing to detect
+    ++given_orientations;
     last_detection_stamp = frame.stamp_s;
     CameraPose given;
     given.R_target_cam = *frame.R_target_cam;
     detections.push_back({frame.stamp_s, given});
+    return;
+  }
+  if (natural_scene) {  // no target: the rest's sharpest frame gives features (at its end)
+    keepSceneCandidate(frame);
     return;
   }
   if (!intrinsics) {
@@ -322,6 +332,7 @@ void CalibrationPipeline::Impl::processMotionFrame(const CameraFrame& frame) {
   MotionFrame motion;
   motion.stamp_s = frame.stamp_s;
   if (frame.R_target_cam) {
+    ++given_orientations;
     motion.R_target_cam = *frame.R_target_cam;
     motion.p_target_cam_m = frame.p_target_cam_m;
     // A given orientation states no covariance: a motion-capture or PnP class 1-sigma; the joint
@@ -329,6 +340,7 @@ void CalibrationPipeline::Impl::processMotionFrame(const CameraFrame& frame) {
     const double sigma_rad = kGivenOrientationSigmaDeg * 3.14159265358979323846 / 180.0;
     motion.cov_cam_rad2 = sigma_rad * sigma_rad * Eigen::Matrix3d::Identity();
   } else {
+    if (natural_scene) return;  // no target to find during motion
     if (!intrinsics || frame.mono8.cols != intrinsics->width ||
         frame.mono8.rows != intrinsics->height) {
       return;  // counted and said by the rests' frames

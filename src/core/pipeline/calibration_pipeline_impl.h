@@ -42,6 +42,13 @@ struct SegmentField {
 /// when the offset cannot be found; returns what was done or why not, for the result's message.
 std::string prepareMotion(const PipelineSettings& settings, WindowSnapshot* window);
 
+/// The joint estimate of a window with natural-scene rotations (scene_assembly.cpp): a wrong
+/// rotation between two views (a near-planar view's two-fold ambiguity, repeated texture) stands
+/// out by its residual; the worst one beyond the chi-square(3) tail of kSceneLinkOutlierLevel is
+/// left out and the window solved again, at most a third of the links. `dropped`: how many.
+JointResult solveJointScreeningSceneLinks(JointProblem problem, const Eigen::Matrix3d& R_start,
+                                          const JointSettings& settings, int* dropped);
+
 struct CalibrationPipeline::Impl {
   Impl(const TargetDescription& target, const PipelineSettings& settings,
        PipelineCallbacks callbacks);
@@ -106,6 +113,26 @@ struct CalibrationPipeline::Impl {
   std::uint64_t motion_frames_total = 0;
   std::uint64_t motion_detections = 0;  ///< frames during motion on which detection ran
 
+  // --- natural scene (no target: TargetDescription::numPoints() == 0; scene_assembly.cpp)
+  bool natural_scene = false;
+  std::uint64_t given_orientations = 0;  ///< frames that came with R_target_cam (camera_pose)
+  /// The sharpest frame at rest so far, per rest (by the stationary detector's rest start).
+  struct SceneCandidate {
+    double stamp_s = 0, sharpness = 0, rest_since_s = 0;
+    cv::Mat mono8;
+  };
+  std::deque<SceneCandidate> scene_candidates;
+  /// The features of accepted poses, newest last (at most window_poses + 1).
+  struct SceneView {
+    int pose_index = 0, scene = 0, group = 0;
+    Eigen::Matrix3d R_scene_cam = Eigen::Matrix3d::Identity();
+    Eigen::Matrix3d R_world_imu = Eigen::Matrix3d::Identity();  ///< the pose's (gyro chain)
+    SceneFeatures features;
+  };
+  std::deque<SceneView> scene_views;
+  int scenes_started = 0;
+  std::uint64_t rotations_refused_by_imu = 0;  ///< scene rotations the IMU's angle contradicts
+
   std::size_t poses_total = 0, rests_total = 0;
   std::uint64_t imu_gaps = 0;  ///< IMU stamp gaps longer than settings.stationary.max_gap_s
 
@@ -131,6 +158,12 @@ struct CalibrationPipeline::Impl {
   void chooseImuOrientation(const StationarySegment& segment, StationaryPose* pose);
   /// The camera orientation from the frames inside the rest; the reason the rest is no pose, or "".
   std::string assessCamera(const StationarySegment& segment, StationaryPose* pose);
+  /// Natural scene: keeps the frame if it is the sharpest of its rest so far.
+  void keepSceneCandidate(const CameraFrame& frame);
+  /// Natural scene: the camera orientation from features matched with earlier rests (the links
+  /// go into `entry`); the reason the rest is no pose, or "".
+  std::string assessScene(const StationarySegment& segment, StationaryPose* pose,
+                          StationaryWindow::Entry* entry);
   /// Adds the pose to the history and the window and reports it (on_pose).
   void acceptPose(const StationaryPose& pose, StationaryWindow::Entry joint_entry);
   /// The rest's measurements for the joint estimate (before the buffers move on); advances

@@ -127,7 +127,10 @@ void CalibrationPipeline::Impl::onSegment(const StationarySegment& segment) {
   integrateGyroSincePrevious(segment, &pose);
   StationaryWindow::Entry joint_entry = jointMeasurements(segment, pose, field);
   chooseImuOrientation(segment, &pose);
-  const std::string rejection = assessCamera(segment, &pose);
+  // Given camera poses (camera_pose) come with an orientation: no scene needed.
+  const std::string rejection = natural_scene && given_orientations == 0
+                                    ? assessScene(segment, &pose, &joint_entry)
+                                    : assessCamera(segment, &pose);
   if (!rejection.empty()) {
     const RejectedPose rejected_pose{segment.start_s, segment.end_s, rejection};
     pushBounded(&rejected, rejected_pose);
@@ -388,8 +391,9 @@ AlignmentResult solveWindow(const WindowSnapshot& window_in, const PipelineSetti
     return result;
   }
   // The joint estimate, started from the pair solve.
-  const JointResult joint =
-      JointEstimator(jointSettingsOf(settings)).solve(window.joint, result.R_cam_imu);
+  int links_dropped = 0;
+  const JointResult joint = solveJointScreeningSceneLinks(
+      window.joint, result.R_cam_imu, jointSettingsOf(settings), &links_dropped);
   const std::string sensors = settings.imu_orientation == ImuOrientationSource::kMagnetometer
                                   ? " (camera, accelerometer, magnetometer; gyro not used)"
                                   : "";
@@ -403,11 +407,21 @@ AlignmentResult solveWindow(const WindowSnapshot& window_in, const PipelineSetti
                                          fmt(1e3 * joint.timeshift_cam_imu_s, 2) + " +- " +
                                          fmt(1e3 * joint.timeshift_sigma_s, 2) + " ms)"
                                    : "";
+    const std::string scene =
+        window.joint.camera_links.empty()
+            ? ""
+            : ", " + std::to_string(window.joint.camera_links.size() - links_dropped) +
+                  " natural-scene rotations" +
+                  (links_dropped > 0 ? " (" + std::to_string(links_dropped) +
+                                           " more left out: residual beyond chi-square(3) "
+                                           "p 1e-4)"
+                                     : "");
     result.message = "joint estimate" + sensors + " over " +
-                     std::to_string(window.joint.poses.size()) + " poses" + motion + ": chi2/dof " +
-                     fmt(joint.dof > 0 ? joint.chi2 / joint.dof : 0.0) + ", 1-sigma [" +
-                     fmt(joint.std_dev_deg.x(), 4) + " " + fmt(joint.std_dev_deg.y(), 4) + " " +
-                     fmt(joint.std_dev_deg.z(), 4) + "] deg; pairs: " + result.message;
+                     std::to_string(window.joint.poses.size()) + " poses" + motion + scene +
+                     ": chi2/dof " + fmt(joint.dof > 0 ? joint.chi2 / joint.dof : 0.0) +
+                     ", 1-sigma [" + fmt(joint.std_dev_deg.x(), 4) + " " +
+                     fmt(joint.std_dev_deg.y(), 4) + " " + fmt(joint.std_dev_deg.z(), 4) +
+                     "] deg; pairs: " + result.message;
   } else {
     result.message = "joint estimate failed (" + joint.message + "); pair solve: " + result.message;
   }

@@ -2,6 +2,7 @@
 #include "camera_imu_alignment/pipeline/stationary_window.h"
 
 #include <algorithm>
+#include <map>
 #include <utility>
 
 #include "camera_imu_alignment/solver/rotation_math.h"
@@ -38,6 +39,7 @@ PoseOrientation orientationOf(const StationaryPose& pose) {
   o.R_target_cam = pose.R_target_cam;
   o.R_world_imu = pose.R_world_imu;
   o.group = pose.group;
+  o.camera_frame = pose.scene;
   return o;
 }
 
@@ -61,6 +63,19 @@ JointProblem StationaryWindow::problem() const {
     segment.from_pose = static_cast<int>(i) - 1;
     segment.to_pose = static_cast<int>(i);
     problem.segments.push_back(std::move(segment));
+  }
+  std::map<int, int> position;  // StationaryPose::index -> index in the window
+  for (std::size_t i = 0; i < entries_.size(); ++i) {
+    position[entries_[i].pose.index] = static_cast<int>(i);
+  }
+  for (const Entry& entry : entries_) {
+    for (CameraLink link : entry.camera_links) {
+      const auto from = position.find(link.from_pose), to = position.find(link.to_pose);
+      if (from == position.end() || to == position.end()) continue;  // left the window
+      link.from_pose = from->second;
+      link.to_pose = to->second;
+      problem.camera_links.push_back(link);
+    }
   }
   return problem;
 }

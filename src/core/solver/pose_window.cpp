@@ -12,7 +12,9 @@ RotationPairs makeAllPairs(const std::vector<PoseOrientation>& poses) {
   pairs.reserve(static_cast<size_t>(P) * (P > 0 ? P - 1 : 0) / 2);
   for (int k = 0; k < P; ++k) {
     for (int t = k + 1; t < P; ++t) {
-      if (poses[k].group != poses[t].group) continue;
+      if (poses[k].group != poses[t].group || poses[k].camera_frame != poses[t].camera_frame) {
+        continue;
+      }
       RotationPair pair;
       pair.A_cam = poses[k].R_target_cam.transpose() * poses[t].R_target_cam;
       pair.B_imu = poses[k].R_world_imu.transpose() * poses[t].R_world_imu;

@@ -1,0 +1,190 @@
+// CalibrationPipeline without a target: each rest's sharpest frame gives natural-scene features;
+// the camera's rotation from earlier rests (vision/scene_rotation.h) links the poses in the joint
+// estimate (JointProblem::camera_links) and chains their orientations in a scene frame for the
+// pair solvers.
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "calibration_pipeline_impl.h"
+#include "camera_imu_alignment/estimation/joint_estimator.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
+
+namespace camera_imu_alignment {
+namespace {
+
+/// Candidate frames kept at most (one per rest: a few rests may end before their frames settle).
+constexpr std::size_t kMaxSceneCandidates = 8;
+/// A camera rotation turns by the angle the IMU turned (an angle needs no R_cam_imu). The IMU's
+/// angle between rests of one gyro chain is good to its scale and cross-axis errors (the joint
+/// prior's, a few percent) plus this floor (deg); a measured rotation further off, by more than
+/// kAngleCheckSigmas of the two combined, is a wrong fit (e.g. the essential matrix's two-fold
+/// ambiguity on a near-planar view) and is not used.
+constexpr double kAngleCheckFloorDeg = 0.2;
+constexpr double kAngleCheckSigmas = 4.0;
+
+std::string fmtStamp(double stamp_s) {
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(2);
+  out << stamp_s;
+  return out.str();
+}
+
+double rmsSigmaDeg(const Eigen::Matrix3d& cov_rad2) {
+  return rad2deg(std::sqrt(std::max(0.0, cov_rad2.trace()) / 3.0));
+}
+
+/// Chi-square(3) upper-tail level beyond which a natural-scene rotation is an outlier.
+constexpr double kSceneLinkOutlierChi2 = 21.108;  // chi-square(3) at p = 1e-4
+
+}  // namespace
+
+JointResult solveJointScreeningSceneLinks(JointProblem problem, const Eigen::Matrix3d& R_start,
+                                          const JointSettings& settings, int* dropped) {
+  *dropped = 0;
+  const JointEstimator estimator(settings);
+  JointResult joint = estimator.solve(problem, R_start);
+  const int max_dropped = static_cast<int>(problem.camera_links.size()) / 3;
+  while (joint.ok && *dropped < max_dropped &&
+         joint.camera_link_chi2.size() == problem.camera_links.size()) {
+    const auto worst =
+        std::max_element(joint.camera_link_chi2.begin(), joint.camera_link_chi2.end());
+    if (worst == joint.camera_link_chi2.end() || *worst < kSceneLinkOutlierChi2) break;
+    problem.camera_links.erase(problem.camera_links.begin() +
+                               (worst - joint.camera_link_chi2.begin()));
+    JointResult again = estimator.solve(problem, joint.R_cam_imu);
+    if (!again.ok) break;
+    joint = std::move(again);
+    ++*dropped;
+  }
+  return joint;
+}
+
+void CalibrationPipeline::Impl::keepSceneCandidate(const CameraFrame& frame) {
+  if (!intrinsics) {
+    ++frames_without_intrinsics;
+    return;
+  }
+  if (frame.mono8.cols != intrinsics->width || frame.mono8.rows != intrinsics->height) {
+    std::ostringstream out;
+    out << frame.mono8.cols << "x" << frame.mono8.rows << " differs from the camera info's "
+        << intrinsics->width << "x" << intrinsics->height << "; frame dropped";
+    reject(RejectReason::kBadImage, InputStream::kImage, out.str());
+    return;
+  }
+  const double rest_since = stationary.restSince().value_or(frame.stamp_s);
+  const double sharpness = imageSharpness(frame.mono8);
+  if (!scene_candidates.empty() && scene_candidates.back().rest_since_s == rest_since) {
+    if (!(sharpness > scene_candidates.back().sharpness)) return;
+    scene_candidates.pop_back();
+  }
+  scene_candidates.push_back({frame.stamp_s, sharpness, rest_since, frame.mono8.clone()});
+  while (scene_candidates.size() > kMaxSceneCandidates) scene_candidates.pop_front();
+}
+
+std::string CalibrationPipeline::Impl::assessScene(const StationarySegment& segment,
+                                                   StationaryPose* pose,
+                                                   StationaryWindow::Entry* entry) {
+  const double lo = segment.start_s + settings.frame_margin_s;
+  const double hi = segment.end_s - settings.frame_margin_s;
+  std::optional<SceneCandidate> best;
+  for (const SceneCandidate& c : scene_candidates) {
+    if (c.stamp_s < lo || c.stamp_s > hi) continue;
+    if (!best || c.sharpness > best->sharpness) best = c;
+  }
+  while (!scene_candidates.empty() && scene_candidates.front().stamp_s <= segment.end_s) {
+    scene_candidates.pop_front();
+  }
+  if (!best) {
+    if (num_frames == 0) return kNoCameraDataReason;
+    if (!intrinsics && frames_without_intrinsics > 0) {
+      return "no camera info received yet (" + std::to_string(frames_without_intrinsics) +
+             " image(s) waiting for it)";
+    }
+    return "natural scene: no image inside the rest";
+  }
+  SceneFeatures features =
+      extractSceneFeatures(best->mono8, *intrinsics, settings.scene_features, best->stamp_s);
+  const int count = static_cast<int>(features.keypoints.size());
+  pose->camera_source = PoseCameraSource::kScene;
+  pose->scene_features = count;
+  if (count < settings.scene_rotation.min_inliers) {
+    return "natural scene: " + std::to_string(count) + " features in the sharpest frame at " +
+           fmtStamp(best->stamp_s) + " s, at least " +
+           std::to_string(settings.scene_rotation.min_inliers) +
+           " needed (a blank wall, a dark room or a blurred view)";
+  }
+  // Matched with the newest earlier rests; the strongest link places the pose in its scene.
+  std::string best_failure = "no inliers";
+  int best_inliers = -1;
+  const SceneView* anchor = nullptr;
+  SceneRotation anchor_rotation;
+  int tried = 0;
+  for (auto it = scene_views.rbegin();
+       it != scene_views.rend() && tried < settings.max_scene_matches; ++it, ++tried) {
+    SceneRotation rotation = estimateSceneRotation(it->features, features, *intrinsics,
+                                                   std::nullopt, settings.scene_rotation);
+    if (rotation.ok && it->group == pose->group) {
+      const double imu_deg =
+          rad2deg(rotationAngle(it->R_world_imu.transpose() * pose->R_world_imu));
+      const double camera_deg = rad2deg(rotationAngle(rotation.R_from_to));
+      const JointSettings& joint = settings.joint;
+      const double scale = std::hypot(joint.priors.gyro_scale, joint.priors.gyro_cross_axis);
+      const double sigma =
+          std::sqrt(std::pow(scale * imu_deg, 2) + std::pow(rmsSigmaDeg(rotation.cov_rad2), 2) +
+                    std::pow(kAngleCheckFloorDeg, 2));
+      if (std::abs(camera_deg - imu_deg) > kAngleCheckSigmas * sigma) {
+        rotation.ok = false;
+        rotation.message = "the camera turned " + fmtStamp(camera_deg) + " deg, the IMU " +
+                           fmtStamp(imu_deg) + " deg (" + std::to_string(rotation.inliers) +
+                           " inliers): not used";
+        ++rotations_refused_by_imu;
+      }
+    }
+    if (!rotation.ok) {
+      if (rotation.inliers > best_inliers) {
+        best_inliers = rotation.inliers;
+        best_failure = "pose " + std::to_string(it->pose_index) + ": " + rotation.message;
+      }
+      continue;
+    }
+    CameraLink link;
+    link.from_pose = it->pose_index;
+    link.to_pose = pose->index;
+    link.R_from_to = rotation.R_from_to;
+    link.cov_rad2 = rotation.cov_rad2;
+    entry->camera_links.push_back(link);
+    pose->scene_links.push_back({it->pose_index, rotation.matches, rotation.inliers, rotation.model,
+                                 rotation.residual_rms_px, rmsSigmaDeg(rotation.cov_rad2),
+                                 rotation.R_from_to});
+    if (!anchor || rotation.inliers > anchor_rotation.inliers) {
+      anchor = &*it;
+      anchor_rotation = rotation;
+    }
+  }
+  if (anchor) {
+    pose->scene = anchor->scene;
+    pose->R_target_cam = projectToSO3(anchor->R_scene_cam * anchor_rotation.R_from_to);
+  } else {
+    // No overlap: the pose starts a new scene, whose frame is unrelated to the earlier ones'. Its
+    // IMU measurements still count; its camera does once a later rest overlaps it.
+    if (tried > 0) {
+      pose->scene_note = "the view at " + fmtStamp(best->stamp_s) + " s (" + std::to_string(count) +
+                         " features) overlaps none of the " + std::to_string(tried) +
+                         " latest rests (best: " + best_failure + "): it starts scene " +
+                         std::to_string(scenes_started);
+    }
+    pose->scene = scenes_started++;
+    pose->R_target_cam = Eigen::Matrix3d::Identity();
+  }
+  pose->num_frames = 1;
+  pose->camera_spread_deg = 0.0;
+  entry->joint.camera_absolute = false;
+  scene_views.push_back({pose->index, pose->scene, pose->group, pose->R_target_cam,
+                         pose->R_world_imu, std::move(features)});
+  while (scene_views.size() > settings.window_poses + 1) scene_views.pop_front();
+  return "";
+}
+
+}  // namespace camera_imu_alignment
