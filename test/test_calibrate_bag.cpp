@@ -226,7 +226,7 @@ TEST(CalibrateBag, TruthAndPosesReachTheSummaryAndTheReport) {
   EXPECT_EQ(out.find("(not in the window)"), std::string::npos) << out;
   const cv::Mat image = cv::imread(page);
   EXPECT_EQ(image.cols, 1200);
-  EXPECT_EQ(image.rows, 1340);
+  EXPECT_EQ(image.rows, 1640);
   removeBag(bag);
 }
 

@@ -259,7 +259,7 @@ TEST(RenderReport, RealisticInputDrawsAPageWithOutliersInRed) {
   ASSERT_FALSE(img.empty());
   EXPECT_EQ(img.type(), CV_8UC3);
   EXPECT_EQ(img.cols, 1200);
-  EXPECT_EQ(img.rows, 1340);
+  EXPECT_EQ(img.rows, kReportHeightPx);
   EXPECT_GT(countColour(img, {30, 30, 220}), 50);    // outlier bar, rejected rest
   EXPECT_GT(countColour(img, {40, 160, 40}), 200);   // accepted poses
   EXPECT_GT(countColour(img, {200, 110, 30}), 200);  // inlier bars, axis points

@@ -167,6 +167,10 @@ void AlignmentWrapper::Impl::publishStatus() {
       s.chi2 = r.joint->chi2;
       s.dof = static_cast<std::uint32_t>(std::max(0, r.joint->dof));
       s.p_value = r.joint->chi2_p_value;
+      s.motion_nodes = static_cast<std::uint32_t>(std::max(0, r.joint->motion_nodes));
+      s.timeshift_estimated = r.joint->timeshift_estimated;
+      s.timeshift_cam_imu_s = r.joint->timeshift_cam_imu_s;
+      s.timeshift_sigma_s = r.joint->timeshift_sigma_s;
     }
   }
   s.poses_needed = snap.progress.poses_needed;

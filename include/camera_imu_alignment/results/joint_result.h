@@ -60,6 +60,28 @@ struct ImuIntrinsics {
   double magnetic_dip_rad = 0;  ///< dip (rad, positive downwards), when used
 };
 
+/// What the report shows of the continuous motion (calibration_report.h), computed once where the
+/// data are: the per-node residuals by the estimator, the rest by the pipeline from the motion
+/// frames and the raw gyro it solved on (calibration_pipeline.h). Empty without motion nodes.
+struct MotionFigures {
+  /// Per motion node in time order: its stamp (s, camera clock) and its RMS whitened residual
+  /// (sigma units, as pose_residual_norm: its camera prior and half of each adjacent gyro and
+  /// accelerometer link; about 1 where the camera and the gyro agree within their noise).
+  std::vector<double> node_stamps_s;
+  std::vector<double> node_residual_sigma;
+  /// The coarse time offset's fit (coarseTimeshift, estimation/time_offset.h): candidate
+  /// timeshift_cam_imu_s (s, ascending, evenly spaced) and at each the RMS difference (rad) of the
+  /// camera's and the gyro's angles per frame interval.
+  std::vector<double> timeshift_candidates_s;
+  std::vector<double> timeshift_rms_difference_rad;
+  double coarse_timeshift_s = 0;  ///< the coarse value (the curve's interpolated minimum, s)
+  /// Rotation the motion frames carried about the camera x, y, z axes (rad): the sum over
+  /// consecutive frames of |Log(R_target_cam_k^T R_target_cam_k+1)| per component
+  /// (motionExcitation, estimation/time_offset.h). Near 0 about an axis the motion never turned.
+  Eigen::Vector3d excitation_rad = Eigen::Vector3d::Zero();
+  double excitation_duration_s = 0;  ///< the frame intervals summed (s)
+};
+
 struct JointResult {
   bool ok = false;
   std::string message;  ///< why not, when !ok; a summary otherwise
@@ -108,6 +130,7 @@ struct JointResult {
   double timeshift_sigma_s = 0;
   bool timeshift_estimated = false;
   int motion_nodes = 0;      ///< motion nodes used (JointProblem::motion_frames)
+  MotionFigures motion;      ///< the motion's figures for the report
   int rests_used = 0;        ///< rests used (JointProblem::poses)
   int iterations = 0;        ///< Levenberg-Marquardt iterations over all passes
   int relinearisations = 0;  ///< gyro preintegration passes

@@ -353,6 +353,18 @@ void mapResultToCaller(const ExpandedProblem& expanded, JointResult* result) {
   result->motion_nodes = expanded.motion_nodes;
   result->rests_used = static_cast<int>(expanded.expanded_pose.size());
   if (expanded.motion_nodes == 0) return;
+  // The nodes' residuals for the report, on the camera clock (their stamps are shifted by the
+  // initial offset, expandMotion).
+  result->motion.node_stamps_s.clear();
+  result->motion.node_residual_sigma.clear();
+  if (result->pose_residual_norm.size() == expanded.caller_pose.size()) {
+    for (size_t k = 0; k < expanded.caller_pose.size(); ++k) {
+      if (expanded.caller_pose[k] >= 0) continue;
+      result->motion.node_stamps_s.push_back(expanded.problem.poses[k].start_s -
+                                             expanded.problem.timeshift_initial_s);
+      result->motion.node_residual_sigma.push_back(result->pose_residual_norm[k]);
+    }
+  }
   const auto select = [&](auto& per_pose) {
     if (per_pose.size() != expanded.caller_pose.size()) return;
     std::remove_reference_t<decltype(per_pose)> kept;

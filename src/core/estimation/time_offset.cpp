@@ -13,6 +13,8 @@ namespace {
 constexpr double kStepS = 1e-3;
 constexpr double kMinAngleRad = 0.5 * 3.14159265358979323846 / 180.0;
 constexpr int kMinIntervals = 20;
+/// Frames at exactly min_interval_s apart (up to the stamps' rounding) are an interval.
+constexpr double kIntervalToleranceS = 1e-4;
 
 /// Integral of the raw gyro from the first sample to t (rad), the rate interpolated linearly
 /// between samples: prefix sums plus the partial trapezoid.
@@ -122,6 +124,10 @@ TimeshiftSearch coarseTimeshift(const std::vector<MotionFrame>& frames, const Gy
   }
   const int best = static_cast<int>(std::min_element(cost.begin(), cost.end()) - cost.begin());
   out.intervals = static_cast<int>(usable.size());
+  for (int i = 0; i <= 2 * steps; ++i) {
+    out.candidates_s.push_back((i - steps) * kStepS);
+    out.rms_difference_rad.push_back(std::sqrt(cost[i] / static_cast<double>(usable.size())));
+  }
   if (best == 0 || best == 2 * steps) {
     char buffer[200];
     std::snprintf(buffer, sizeof(buffer),
@@ -138,6 +144,26 @@ TimeshiftSearch coarseTimeshift(const std::vector<MotionFrame>& frames, const Gy
   out.timeshift_cam_imu_s = (best - steps + std::clamp(offset, -0.5, 0.5)) * kStepS;
   out.rms_angle_difference_rad = std::sqrt(b / static_cast<double>(usable.size()));
   out.ok = true;
+  return out;
+}
+
+MotionExcitation motionExcitation(const std::vector<MotionFrame>& frames, double min_interval_s,
+                                  double max_interval_s) {
+  MotionExcitation out;
+  size_t from = 0;
+  for (size_t k = 1; k < frames.size(); ++k) {
+    const double dt = frames[k].stamp_s - frames[from].stamp_s;
+    if (dt < min_interval_s - kIntervalToleranceS) continue;
+    if (dt <= max_interval_s) {
+      const Eigen::Vector3d turn =
+          logSO3(frames[from].R_target_cam.transpose() * frames[k].R_target_cam);
+      if (turn.allFinite()) {
+        out.about_cam_rad += turn.cwiseAbs();
+        out.duration_s += dt;
+      }
+    }
+    from = k;
+  }
   return out;
 }
 

@@ -19,6 +19,7 @@
 namespace camera_imu_alignment {
 namespace {
 
+using report_draw::drawMotionPanel;
 using report_draw::drawPosePanel;
 using report_draw::kBlack;
 using report_draw::kBlue;
@@ -298,7 +299,9 @@ void jointLine(const AlignmentResult& r, std::string* text, cv::Scalar* colour) 
     *text = "joint estimate: FAILED (" + r.joint->message + "); the pair estimate is shown";
     *colour = kRed;
   } else {
-    *text = "joint estimate: " + jointConsistencyText(*r.joint);
+    *text = "joint estimate: " + jointConsistencyText(*r.joint) +
+            "; data used: " + dataUsed(*r.joint) + " (" + std::to_string(r.joint->rests_used) +
+            " rest(s), " + std::to_string(r.joint->motion_nodes) + " motion nodes)";
     *colour = r.joint->consistent() ? kGreen : kRed;
   }
 }
@@ -375,6 +378,7 @@ cv::Mat renderReport(const ReportInput& input) {
   drawTimeline(img, cv::Rect(5, 418, 1190, 160), input);
   drawPosePanel(img, cv::Rect(5, 586, 1190, 400), figures);
   drawEstimateText(img, cv::Rect(5, 994, 1190, 341), input, figures);
+  drawMotionPanel(img, cv::Rect(5, 1343, 1190, 292), input);
   return img;
 }
 

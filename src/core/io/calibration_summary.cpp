@@ -113,6 +113,11 @@ void writeJoint(std::ostream& out, const JointResult& j) {
     out.flags(flags);
     out.precision(precision);
   }
+  if (j.motion_nodes > 0 && j.motion.excitation_duration_s > 0.0) {
+    out << "  motion: rotation about camera x, y, z (deg): "
+        << fixedList(rad2deg(1.0) * j.motion.excitation_rad, 1) << " over "
+        << fixed(j.motion.excitation_duration_s, 1) << " s\n";
+  }
   const ImuIntrinsics& i = j.intrinsics;
   // Every parameter is estimated with its prior; "estimated": the data determined it.
   const auto state = [](bool estimated) {

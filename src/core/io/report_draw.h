@@ -1,6 +1,6 @@
 // Drawing helpers of the PNG report (calibration_report.cpp) and its per-pose panel
-// (report_pose_panel.cpp): OpenCV primitives, BGR colours, pixel coordinates. Private to the io
-// room; not installed.
+// (report_pose_panel.cpp) and motion panel (report_motion_panel.cpp): OpenCV primitives, BGR
+// colours, pixel coordinates. Private to the io room; not installed.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -41,6 +41,12 @@ double niceCeil(double value);
 /// pose axis: the mount offset about camera x, y, z (deg), the RMS residual of each pose's pairs
 /// (deg), the joint estimate's whitened residual (sigma) and the reprojection error (px).
 void drawPosePanel(cv::Mat& img, const cv::Rect& panel, const ReportFigures& figures);
+
+/// Panel (f): the continuous motion (JointResult::motion): each motion node's whitened residual
+/// against time, the time offset's coarse fit around the estimate with the joint estimate and its
+/// 1-sigma, the rotation the motion carried about each camera axis, and which data were used. A
+/// grey note when the estimate used no motion nodes.
+void drawMotionPanel(cv::Mat& img, const cv::Rect& panel, const ReportInput& input);
 
 }  // namespace report_draw
 }  // namespace camera_imu_alignment

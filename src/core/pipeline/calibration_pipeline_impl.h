@@ -40,7 +40,9 @@ struct SegmentField {
 /// gyro's noise into the joint problem, and pairs of motion nodes when the window has no rest
 /// pairs (for the pair solvers and the joint estimate's start). The motion frames are dropped
 /// when the offset cannot be found; returns what was done or why not, for the result's message.
-std::string prepareMotion(const PipelineSettings& settings, WindowSnapshot* window);
+/// `figures` gets the coarse offset's curve and the motion's excitation (JointResult::motion).
+std::string prepareMotion(const PipelineSettings& settings, WindowSnapshot* window,
+                          MotionFigures* figures);
 
 /// The joint estimate of a window with natural-scene rotations (scene_assembly.cpp): a wrong
 /// rotation between two views (a near-planar view's two-fold ambiguity, repeated texture) stands

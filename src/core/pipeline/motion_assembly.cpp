@@ -38,10 +38,18 @@ void CalibrationPipeline::Impl::addMotion(double from_s, JointProblem* problem) 
   gyro.accel_noise_density_m_s2_sqrt_hz = whiteNoiseDensityOf(gyro.stamps_s, gyro.accel_m_s2);
 }
 
-std::string prepareMotion(const PipelineSettings& settings, WindowSnapshot* window) {
+std::string prepareMotion(const PipelineSettings& settings, WindowSnapshot* window,
+                          MotionFigures* figures) {
   JointProblem& joint = window->joint;
   const TimeshiftSearch coarse =
       coarseTimeshift(joint.motion_frames, joint.motion_gyro, settings.max_timeshift_s);
+  // The report's figures of the motion (JointResult::motion), once, from the data solved on.
+  figures->timeshift_candidates_s = coarse.candidates_s;
+  figures->timeshift_rms_difference_rad = coarse.rms_difference_rad;
+  figures->coarse_timeshift_s = coarse.timeshift_cam_imu_s;
+  const MotionExcitation excitation = motionExcitation(joint.motion_frames);
+  figures->excitation_rad = excitation.about_cam_rad;
+  figures->excitation_duration_s = excitation.duration_s;
   if (!coarse.ok) {
     joint.motion_frames.clear();
     joint.motion_gyro = GyroStream{};

@@ -373,8 +373,10 @@ WindowSnapshot CalibrationPipeline::Impl::snapshot() const {
 AlignmentResult solveWindow(const WindowSnapshot& window_in, const PipelineSettings& settings) {
   WindowSnapshot window = window_in;
   std::string motion_note;
+  MotionFigures motion_figures;
   if (!window.joint.motion_frames.empty()) {
-    motion_note = prepareMotion(settings, &window);  // the time offset's start, motion pairs
+    // The time offset's start, motion pairs, the report's figures of the motion.
+    motion_note = prepareMotion(settings, &window, &motion_figures);
   }
   const RotationPairs& pairs = window.pairs;
   if (pairs.empty()) {
@@ -426,6 +428,11 @@ AlignmentResult solveWindow(const WindowSnapshot& window_in, const PipelineSetti
     result.message = "joint estimate failed (" + joint.message + "); pair solve: " + result.message;
   }
   result.joint = joint;
+  if (joint.motion_nodes > 0) {  // the estimator's per-node residuals, the pipeline's curve
+    motion_figures.node_stamps_s = joint.motion.node_stamps_s;
+    motion_figures.node_residual_sigma = joint.motion.node_residual_sigma;
+    result.joint->motion = std::move(motion_figures);
+  }
   return result;
 }
 
