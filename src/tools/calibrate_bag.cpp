@@ -201,10 +201,6 @@ int run(const cia::CliArgs& args) {
   if (!topics.camera_source_note.empty()) {
     std::cerr << "[calibrate_bag] " << topics.camera_source_note << "\n";
   }
-  if (!camera_poses && topics.image.empty()) {
-    std::cerr << "calibrate_bag: " << bag_path << ": " << kNoCameraData << "\n";
-    return kExitBadInput;
-  }
   std::cerr << "[calibrate_bag] " << bag_path << ": IMU " << topics.imu << ", magnetometer "
             << (topics.mag.empty() ? "(none)" : topics.mag);
   if (camera_poses) {
