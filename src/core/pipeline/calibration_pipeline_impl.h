@@ -118,7 +118,7 @@ struct CalibrationPipeline::Impl {
   // --- natural scene (no target: TargetDescription::numPoints() == 0; scene_assembly.cpp)
   bool natural_scene = false;
   std::uint64_t given_orientations = 0;  ///< frames that came with R_target_cam (camera_pose)
-  /// The sharpest frame at rest so far, per rest (by the stationary detector's rest start).
+  /// Frames at rest (min_frame_interval_s apart) since the last rest ended.
   struct SceneCandidate {
     double stamp_s = 0, sharpness = 0, rest_since_s = 0;
     cv::Mat mono8;

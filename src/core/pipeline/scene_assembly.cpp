@@ -13,8 +13,9 @@
 namespace camera_imu_alignment {
 namespace {
 
-/// Candidate frames kept at most (one per rest: a few rests may end before their frames settle).
-constexpr std::size_t kMaxSceneCandidates = 8;
+/// Frames at rest kept (min_frame_interval_s apart) until their rest ends, when the sharpest inside
+/// the rest's margins is taken: at most this many (about 10 s of rest at the default interval).
+constexpr std::size_t kMaxSceneCandidates = 64;
 /// A camera rotation turns by the angle the IMU turned (an angle needs no R_cam_imu). The IMU's
 /// angle between rests of one gyro chain is good to its scale and cross-axis errors (the joint
 /// prior's, a few percent) plus this floor (deg); a measured rotation further off, by more than
@@ -73,13 +74,15 @@ void CalibrationPipeline::Impl::keepSceneCandidate(const CameraFrame& frame) {
     reject(RejectReason::kBadImage, InputStream::kImage, out.str());
     return;
   }
-  const double rest_since = stationary.restSince().value_or(frame.stamp_s);
-  const double sharpness = imageSharpness(frame.mono8);
-  if (!scene_candidates.empty() && scene_candidates.back().rest_since_s == rest_since) {
-    if (!(sharpness > scene_candidates.back().sharpness)) return;
-    scene_candidates.pop_back();
+  // Which frame is the sharpest inside the rest is known only when the rest ends (its margins):
+  // every frame is kept, spaced as detection would be.
+  if (!scene_candidates.empty() &&
+      frame.stamp_s - scene_candidates.back().stamp_s < settings.min_frame_interval_s) {
+    return;
   }
-  scene_candidates.push_back({frame.stamp_s, sharpness, rest_since, frame.mono8.clone()});
+  const double rest_since = stationary.restSince().value_or(frame.stamp_s);
+  scene_candidates.push_back(
+      {frame.stamp_s, imageSharpness(frame.mono8), rest_since, frame.mono8.clone()});
   while (scene_candidates.size() > kMaxSceneCandidates) scene_candidates.pop_front();
 }
 
@@ -115,6 +118,18 @@ std::string CalibrationPipeline::Impl::assessScene(const StationarySegment& segm
            std::to_string(settings.scene_rotation.min_inliers) +
            " needed (a blank wall, a dark room or a blurred view)";
   }
+  // The IMU's prediction of each rotation once the window's pairs give an R_cam_imu (seeds the
+  // two-view fit: a near-planar view's essential matrix is ambiguous).
+  std::optional<Eigen::Matrix3d> R_cam_imu_guess;
+  if (window.size() >= 3) {
+    const RotationPairs pairs = window.pairs();
+    if (!pairs.empty()) {
+      const AlignmentResult guess = solveAlignment(pairs, settings.solver);
+      if (guess.status == SolveStatus::kOk && guess.R_cam_imu.allFinite()) {
+        R_cam_imu_guess = guess.R_cam_imu;
+      }
+    }
+  }
   // Matched with the newest earlier rests; the strongest link places the pose in its scene.
   std::string best_failure = "no inliers";
   int best_inliers = -1;
@@ -123,8 +138,13 @@ std::string CalibrationPipeline::Impl::assessScene(const StationarySegment& segm
   int tried = 0;
   for (auto it = scene_views.rbegin();
        it != scene_views.rend() && tried < settings.max_scene_matches; ++it, ++tried) {
-    SceneRotation rotation = estimateSceneRotation(it->features, features, *intrinsics,
-                                                   std::nullopt, settings.scene_rotation);
+    std::optional<Eigen::Matrix3d> prediction;
+    if (R_cam_imu_guess && it->group == pose->group) {
+      prediction = *R_cam_imu_guess * it->R_world_imu.transpose() * pose->R_world_imu *
+                   R_cam_imu_guess->transpose();
+    }
+    SceneRotation rotation = estimateSceneRotation(it->features, features, *intrinsics, prediction,
+                                                   settings.scene_rotation);
     if (rotation.ok && it->group == pose->group) {
       const double imu_deg =
           rad2deg(rotationAngle(it->R_world_imu.transpose() * pose->R_world_imu));

@@ -395,6 +395,15 @@ ModelFit fitGeneral(const BearingMatches& m, double threshold_px, bool screen) {
   return refineAndSelect(m, s, threshold_px, true, screen);
 }
 
+ModelFit fitGeneralFrom(const BearingMatches& m, double threshold_px, const Matrix3d& R_from_to,
+                        const Vector3d& t_from) {
+  if (m.from.size() < 6 || !(t_from.norm() > 0)) return ModelFit();
+  State s;
+  s.R = projectToSO3(R_from_to);
+  s.t = t_from.normalized();
+  return refineAndSelect(m, s, threshold_px, true, true);
+}
+
 double gric(const ModelFit& fit, const std::vector<bool>& counted, double sigma_px,
             int parameters) {
   const double sigma2 = std::max(sigma_px * sigma_px, kMinSigmaPx * kMinSigmaPx);

@@ -52,6 +52,12 @@ ModelFit fitRotationOnly(const BearingMatches& matches, double threshold_px,
 /// which would cost time and bias the model choice).
 ModelFit fitGeneral(const BearingMatches& matches, double threshold_px, bool screen);
 
+/// The general model refined from a given rotation and translation direction (e.g. a gyro
+/// prediction: a near-planar view has two essential matrices that explain it about equally, and
+/// RANSAC's may be the wrong one), with the screens.
+ModelFit fitGeneralFrom(const BearingMatches& matches, double threshold_px,
+                        const Eigen::Matrix3d& R_from_to, const Eigen::Vector3d& t_from);
+
 /// Torr's GRIC of a fit (lower is better) over the matches flagged in `counted`, with the
 /// common noise `sigma_px`: sum of min(d^2 / sigma^2, 2 codim) + n d ln 4 + k ln 4n, where
 /// d = 4 - codim is the model manifold's dimension and k its parameter count (3 or 5).

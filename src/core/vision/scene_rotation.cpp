@@ -20,6 +20,9 @@ namespace camera_imu_alignment {
 namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
+/// The general model refined from a prediction replaces RANSAC's when it keeps at least this share
+/// of its inliers (the two solutions of a near-planar view explain about the same matches).
+constexpr double kSeededInlierShare = 0.9;
 /// OpenCV's SIFT finds keypoints in the image upsampled 2x (bilinear, pixel centres at integer
 /// coordinates) and halves their coordinates, which puts them a quarter pixel right of and below
 /// the image's own pixel grid. Uncorrected, the offset acts as a principal point error: 0.0023 deg
@@ -184,8 +187,23 @@ SceneRotation estimateSceneRotation(const SceneFeatures& from, const SceneFeatur
     use_rotation = scene_geometry::gric(rotation, counted, sigma_px, 3) <=
                    scene_geometry::gric(general, counted, sigma_px, 5);
   }
-  if (!use_rotation)
+  if (!use_rotation) {
     general = scene_geometry::fitGeneral(matches, settings.ransac_threshold_px, true);
+    // A near-planar view has two essential matrices that explain it about equally well: with a
+    // prediction, the one refined from it is taken when it explains nearly as many matches and is
+    // nearer the prediction.
+    if (R_from_to_prediction && general.found) {
+      const scene_geometry::ModelFit seeded = scene_geometry::fitGeneralFrom(
+          matches, settings.ransac_threshold_px, *R_from_to_prediction, general.t_from);
+      const auto off = [&](const Eigen::Matrix3d& R) {
+        return rotationAngle(R_from_to_prediction->transpose() * R);
+      };
+      if (seeded.found && seeded.inliers >= kSeededInlierShare * general.inliers &&
+          off(seeded.R_from_to) < off(general.R_from_to)) {
+        general = seeded;
+      }
+    }
+  }
   const scene_geometry::ModelFit& fit = use_rotation ? rotation : general;
   result.inliers = fit.found ? fit.inliers : 0;
   why << ", " << result.inliers << " inliers";

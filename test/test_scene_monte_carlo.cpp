@@ -1,0 +1,65 @@
+// Calibration without a board, Monte Carlo (issue 26's targets; labelled statistical): 20 seeds of
+// the simulator's room scenarios with a consumer IMU (scene_sessions.h). Robot stops: RMS error,
+// and the reported 1-sigma covering the errors whenever the chi-square test passes. Hand-held:
+// measured and printed (not met: near-planar views, BENCHMARKS.md), never confidently wrong.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <vector>
+
+#include "scene_sessions.h"
+
+namespace camera_imu_alignment {
+namespace {
+
+struct Statistics {
+  std::vector<double> error_deg;  ///< of the consistent estimates
+  int consistent = 0, within_3_sigma = 0, seeds = 0;
+};
+
+Statistics runSeeds(const std::string& scenario) {
+  Statistics s;
+  for (std::uint64_t seed = 100; seed < 120; ++seed) {
+    const test::SceneOutcome o = test::runScene(scenario, seed);
+    ++s.seeds;
+    if (!o.consistent) continue;
+    ++s.consistent;
+    s.error_deg.push_back(o.error_deg);
+    s.within_3_sigma += o.error_deg < 3.0 * o.sigma_norm_deg;
+  }
+  double sum = 0;
+  for (double e : s.error_deg) sum += e * e;
+  std::printf("%s, %d seeds: %d consistent, RMS %.4f deg over them, %d within 3 sigma\n",
+              scenario.c_str(), s.seeds, s.consistent,
+              s.error_deg.empty() ? 0.0 : std::sqrt(sum / s.error_deg.size()), s.within_3_sigma);
+  return s;
+}
+
+double rms(const std::vector<double>& v) {
+  double sum = 0;
+  for (double x : v) sum += x * x;
+  return v.empty() ? 0.0 : std::sqrt(sum / v.size());
+}
+
+// The issue's target is 0.10 deg RMS, not met: measured 0.181 (20/20 consistent, all within 3
+// sigma, 1-sigma norms about 0.2 deg: the robot turns mostly about the vertical, tilted 5-20 deg;
+// 2026-11-27). Asserted: honesty, and the measured level with a margin.
+TEST(SceneMonteCarlo, RobotStopsConsumer) {
+  const Statistics s = runSeeds("room_robot");
+  EXPECT_GE(s.consistent, 18);
+  EXPECT_EQ(s.within_3_sigma, s.consistent);
+  EXPECT_LE(rms(s.error_deg), 0.25);
+}
+
+// Measured (2026-11-27): 8 of 20 consistent, RMS 0.063 deg over them, all 8 within 3 sigma; the
+// other 12 fail the chi-square test (wrong rotations from near-planar views outnumber what the
+// screening removes): no confident wrong answer, but no answer either.
+TEST(SceneMonteCarlo, HandHeldConsumerNeverConfidentlyWrong) {
+  const Statistics s = runSeeds("room_handheld");
+  EXPECT_EQ(s.within_3_sigma, s.consistent);
+}
+
+}  // namespace
+}  // namespace camera_imu_alignment
