@@ -276,10 +276,6 @@ void CalibrationPipeline::Impl::processFrame(const CameraFrame& frame) {
     detections.push_back({frame.stamp_s, given});
     return;
   }
-  if (natural_scene) {  // no target: the rest's sharpest frame gives features (at its end)
-    keepSceneCandidate(frame);
-    return;
-  }
   if (!intrinsics) {
     ++frames_without_intrinsics;
     return;
@@ -289,6 +285,10 @@ void CalibrationPipeline::Impl::processFrame(const CameraFrame& frame) {
     out << frame.mono8.cols << "x" << frame.mono8.rows << " differs from the camera info's "
         << intrinsics->width << "x" << intrinsics->height << "; frame dropped";
     reject(RejectReason::kBadImage, InputStream::kImage, out.str());
+    return;
+  }
+  if (natural_scene) {  // no target: the rest's sharpest frame gives features (at its end)
+    keepSceneCandidate(frame);
     return;
   }
   last_detection_stamp = frame.stamp_s;

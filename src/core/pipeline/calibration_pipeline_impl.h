@@ -5,6 +5,7 @@
 #include <deque>
 #include <limits>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,15 @@
 #include "rest_statistics.h"
 
 namespace camera_imu_alignment {
+
+/// `value` with `precision` decimals, for the pipeline's messages.
+inline std::string fmt(double value, int precision = 2) {
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(precision);
+  out << value;
+  return out.str();
+}
 
 /// 1-sigma (deg per axis) assumed for a camera orientation given without covariance (camera_pose).
 constexpr double kGivenOrientationSigmaDeg = 0.05;
@@ -120,7 +130,7 @@ struct CalibrationPipeline::Impl {
   std::uint64_t given_orientations = 0;  ///< frames that came with R_target_cam (camera_pose)
   /// Frames at rest (min_frame_interval_s apart) since the last rest ended.
   struct SceneCandidate {
-    double stamp_s = 0, sharpness = 0, rest_since_s = 0;
+    double stamp_s = 0, sharpness = 0;
     cv::Mat mono8;
   };
   std::deque<SceneCandidate> scene_candidates;
@@ -160,6 +170,8 @@ struct CalibrationPipeline::Impl {
   void chooseImuOrientation(const StationarySegment& segment, StationaryPose* pose);
   /// The camera orientation from the frames inside the rest; the reason the rest is no pose, or "".
   std::string assessCamera(const StationarySegment& segment, StationaryPose* pose);
+  /// Why a rest has no camera frame when no camera data or no camera info came at all, else "".
+  std::string silentCameraReason() const;
   /// Natural scene: keeps the frame if it is the sharpest of its rest so far.
   void keepSceneCandidate(const CameraFrame& frame);
   /// Natural scene: the camera orientation from features matched with earlier rests (the links

@@ -61,14 +61,6 @@ std::optional<Eigen::Matrix3d> messageOrientation(const std::deque<ImuSample>& s
   return Eigen::Quaterniond(sum(3), sum(0), sum(1), sum(2)).toRotationMatrix();
 }
 
-std::string fmt(double value, int precision = 2) {
-  std::ostringstream out;
-  out.setf(std::ios::fixed);
-  out.precision(precision);
-  out << value;
-  return out.str();
-}
-
 /// The board may look the same turned (TargetDetector::symmetries): among the readings
 /// S * R_target_cam, the right one turns the camera by the same angle as the IMU since the earlier
 /// poses of the group (a rotation angle does not depend on the frame). Keeps the detector's reading
@@ -296,13 +288,8 @@ std::string CalibrationPipeline::Impl::assessCamera(const StationarySegment& seg
   const std::string refused_text = camera_model.endRest(lo, hi, segment.end_s);
 
   if (static_cast<int>(rotations.size()) < settings.min_frames_per_pose) {
-    // Nothing arrived at all: the caller may name the silent topic (kNoCameraDataReason). Images
-    // that came without intrinsics are the camera info's fault.
-    if (num_frames == 0) return kNoCameraDataReason;
-    if (!intrinsics && frames_without_intrinsics > 0) {
-      return "no camera info received yet (" + std::to_string(frames_without_intrinsics) +
-             " image(s) waiting for it)";
-    }
+    const std::string silent = silentCameraReason();
+    if (!silent.empty()) return silent;
     std::string out = "target seen in " + std::to_string(rotations.size() + refused) +
                       " frame(s), " + std::to_string(settings.min_frames_per_pose) +
                       (refused > 0 ? " with a camera pose needed; " + refused_text : " needed");
@@ -322,6 +309,17 @@ std::string CalibrationPipeline::Impl::assessCamera(const StationarySegment& seg
   pose->camera_spread_deg = average.spread_rms_deg;
   pose->reprojection_rms_px = reprojection_sum / static_cast<double>(rotations.size());
   pose->camera_pnp_cov_rad2 = pnp_cov_sum / static_cast<double>(rotations.size());
+  return "";
+}
+
+std::string CalibrationPipeline::Impl::silentCameraReason() const {
+  // Nothing arrived at all: the caller may name the silent topic (kNoCameraDataReason). Images
+  // that came without intrinsics are the camera info's fault.
+  if (num_frames == 0) return kNoCameraDataReason;
+  if (!intrinsics && frames_without_intrinsics > 0) {
+    return "no camera info received yet (" + std::to_string(frames_without_intrinsics) +
+           " image(s) waiting for it)";
+  }
   return "";
 }
 

@@ -24,14 +24,6 @@ constexpr std::size_t kMaxSceneCandidates = 64;
 constexpr double kAngleCheckFloorDeg = 0.2;
 constexpr double kAngleCheckSigmas = 4.0;
 
-std::string fmtStamp(double stamp_s) {
-  std::ostringstream out;
-  out.setf(std::ios::fixed);
-  out.precision(2);
-  out << stamp_s;
-  return out.str();
-}
-
 double rmsSigmaDeg(const Eigen::Matrix3d& cov_rad2) {
   return rad2deg(std::sqrt(std::max(0.0, cov_rad2.trace()) / 3.0));
 }
@@ -63,26 +55,13 @@ JointResult solveJointScreeningSceneLinks(JointProblem problem, const Eigen::Mat
 }
 
 void CalibrationPipeline::Impl::keepSceneCandidate(const CameraFrame& frame) {
-  if (!intrinsics) {
-    ++frames_without_intrinsics;
-    return;
-  }
-  if (frame.mono8.cols != intrinsics->width || frame.mono8.rows != intrinsics->height) {
-    std::ostringstream out;
-    out << frame.mono8.cols << "x" << frame.mono8.rows << " differs from the camera info's "
-        << intrinsics->width << "x" << intrinsics->height << "; frame dropped";
-    reject(RejectReason::kBadImage, InputStream::kImage, out.str());
-    return;
-  }
   // Which frame is the sharpest inside the rest is known only when the rest ends (its margins):
   // every frame is kept, spaced as detection would be.
   if (!scene_candidates.empty() &&
       frame.stamp_s - scene_candidates.back().stamp_s < settings.min_frame_interval_s) {
     return;
   }
-  const double rest_since = stationary.restSince().value_or(frame.stamp_s);
-  scene_candidates.push_back(
-      {frame.stamp_s, imageSharpness(frame.mono8), rest_since, frame.mono8.clone()});
+  scene_candidates.push_back({frame.stamp_s, imageSharpness(frame.mono8), frame.mono8.clone()});
   while (scene_candidates.size() > kMaxSceneCandidates) scene_candidates.pop_front();
 }
 
@@ -100,12 +79,8 @@ std::string CalibrationPipeline::Impl::assessScene(const StationarySegment& segm
     scene_candidates.pop_front();
   }
   if (!best) {
-    if (num_frames == 0) return kNoCameraDataReason;
-    if (!intrinsics && frames_without_intrinsics > 0) {
-      return "no camera info received yet (" + std::to_string(frames_without_intrinsics) +
-             " image(s) waiting for it)";
-    }
-    return "natural scene: no image inside the rest";
+    const std::string silent = silentCameraReason();
+    return silent.empty() ? "natural scene: no image inside the rest" : silent;
   }
   SceneFeatures features =
       extractSceneFeatures(best->mono8, *intrinsics, settings.scene_features, best->stamp_s);
@@ -114,7 +89,7 @@ std::string CalibrationPipeline::Impl::assessScene(const StationarySegment& segm
   pose->scene_features = count;
   if (count < settings.scene_rotation.min_inliers) {
     return "natural scene: " + std::to_string(count) + " features in the sharpest frame at " +
-           fmtStamp(best->stamp_s) + " s, at least " +
+           fmt(best->stamp_s) + " s, at least " +
            std::to_string(settings.scene_rotation.min_inliers) +
            " needed (a blank wall, a dark room or a blurred view)";
   }
@@ -156,8 +131,8 @@ std::string CalibrationPipeline::Impl::assessScene(const StationarySegment& segm
                     std::pow(kAngleCheckFloorDeg, 2));
       if (std::abs(camera_deg - imu_deg) > kAngleCheckSigmas * sigma) {
         rotation.ok = false;
-        rotation.message = "the camera turned " + fmtStamp(camera_deg) + " deg, the IMU " +
-                           fmtStamp(imu_deg) + " deg (" + std::to_string(rotation.inliers) +
+        rotation.message = "the camera turned " + fmt(camera_deg) + " deg, the IMU " +
+                           fmt(imu_deg) + " deg (" + std::to_string(rotation.inliers) +
                            " inliers): not used";
         ++rotations_refused_by_imu;
       }
@@ -190,7 +165,7 @@ std::string CalibrationPipeline::Impl::assessScene(const StationarySegment& segm
     // No overlap: the pose starts a new scene, whose frame is unrelated to the earlier ones'. Its
     // IMU measurements still count; its camera does once a later rest overlaps it.
     if (tried > 0) {
-      pose->scene_note = "the view at " + fmtStamp(best->stamp_s) + " s (" + std::to_string(count) +
+      pose->scene_note = "the view at " + fmt(best->stamp_s) + " s (" + std::to_string(count) +
                          " features) overlaps none of the " + std::to_string(tried) +
                          " latest rests (best: " + best_failure + "): it starts scene " +
                          std::to_string(scenes_started);
