@@ -6,7 +6,9 @@
 // kept); on rendered frames of the waving scenario: every sharp frame kept, frames with a
 // mis-detected corner dropped, and frames blurred by a 60 ms exposure at 50-100 deg/s kept because
 // their fit is as good (the simulator's blur is symmetric about the capture time: the corners stay
-// at the streaks' centres).
+// at the streaks' centres). The pipeline's motion frames (screenMotionFrames): judged the same way,
+// the setting max_reprojection_rms_px only when fewer than 10 frames have a fit; through the
+// pipeline, rendered waving frames are kept under a pixel threshold chosen for another camera.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -158,6 +160,75 @@ TEST(FrameScreening, RenderedSharpAndBlurredFramesAreKeptAndAMisdetectedCornerDr
   }
   std::printf("typical %.3f px, spread of log r %.2f: %s\n", screening.typical_rms_px,
               screening.spread, screening.note.c_str());
+}
+
+MotionFrame frameWithFit(double stamp_s, double rms_px, int dof) {
+  MotionFrame frame;
+  frame.stamp_s = stamp_s;
+  frame.reprojection_rms_px = rms_px;
+  frame.reprojection_dof = dof;
+  return frame;
+}
+
+TEST(MotionFrameScreening, TheWindowsFramesAreJudgedByEachOtherAndTheDroppedErased) {
+  std::mt19937_64 rng(11);
+  std::vector<MotionFrame> frames;
+  std::vector<double> poor_stamps;
+  for (int k = 0; k < 60; ++k) {
+    const bool bad = k % 20 == 3;
+    const FrameFit fit = drawnFit(rng, 48, bad ? 10.0 : 1.5);  // a camera at 1.5 px
+    frames.push_back(frameWithFit(0.05 * k, fit.reprojection_rms_px, fit.dof));
+    if (bad) poor_stamps.push_back(frames.back().stamp_s);
+  }
+  frames.push_back(frameWithFit(3.5, 0.0, 0));  // a given orientation: kept
+  const FrameScreening screening = screenMotionFrames(&frames, 1.0);
+  EXPECT_EQ(screening.dropped, 3) << screening.note;
+  ASSERT_EQ(frames.size(), 58u);
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    EXPECT_EQ(std::count(poor_stamps.begin(), poor_stamps.end(), frames[k].stamp_s), 0);
+    if (k > 0) EXPECT_GT(frames[k].stamp_s, frames[k - 1].stamp_s) << "stamp order kept";
+  }
+  EXPECT_GT(screening.typical_rms_px, 1.0) << "above the 1 px setting, and kept";
+}
+
+TEST(MotionFrameScreening, TooFewFramesToJudgeFallBackToTheSetting) {
+  std::vector<MotionFrame> frames = {frameWithFit(0.0, 0.2, 90), frameWithFit(0.1, 0.3, 90),
+                                     frameWithFit(0.2, 1.6, 90), frameWithFit(0.3, 0.25, 90),
+                                     frameWithFit(0.4, 2.0, 0)};  // a given orientation
+  const FrameScreening screening = screenMotionFrames(&frames, 1.0);
+  EXPECT_EQ(screening.dropped, 1);
+  ASSERT_EQ(frames.size(), 4u);
+  EXPECT_EQ(frames[2].stamp_s, 0.3);
+  EXPECT_NE(screening.note.find("max_reprojection_rms_px"), std::string::npos) << screening.note;
+}
+
+// Through the pipeline: 20 s of the waving scenario rendered at 10 Hz, PnP on every frame, with a
+// pixel threshold chosen for another camera (0.01 px; these frames fit at 0.02-0.1 px). Every
+// motion frame was refused by it before the frames were judged against each other; now they are
+// kept, none dropped, and the motion calibrates R_cam_imu within its 3-sigma.
+TEST(MotionFrameScreening, RenderedWavingFramesAreNotJudgedByAnotherCamerasThreshold) {
+  simulation::SimulationConfig c =
+      test::wavingConfig(simulation::ImuGrade::kConsumer, 4, 0.015, 10.0);
+  c.waving_duration_s = 20.0;
+  c.images = true;
+  const simulation::SimulationRun run(c);
+  PipelineSettings settings;
+  settings.pose.max_reprojection_rms_px = 0.01;
+  settings.joint = test::jointSettingsFor(c);
+  CalibrationPipeline pipeline(test::simulatedTarget(c), settings);
+  test::feedRenderedRun(run, &pipeline);
+  pipeline.finish();
+  EXPECT_GT(pipeline.motionFrames(), 150u) << "frames with the target in view, 200 rendered";
+  const AlignmentResult result = solveWindow(pipeline.snapshot(), pipeline.settings());
+  ASSERT_TRUE(result.joint && result.joint->ok) << result.message;
+  EXPECT_EQ(result.joint->motion.frames_dropped, 0);
+  EXPECT_GT(result.joint->motion_nodes, 50);
+  const double error_deg =
+      test::angleBetweenDeg(result.R_cam_imu, run.trajectory.R_cam_imu_final());
+  std::printf("%llu motion frames, %d nodes: %.3f deg from the truth, 1-sigma norm %.3f deg\n",
+              static_cast<unsigned long long>(pipeline.motionFrames()), result.joint->motion_nodes,
+              error_deg, result.quality.std_dev_deg.norm());
+  EXPECT_LT(error_deg, 3.0 * result.quality.std_dev_deg.norm());
 }
 
 }  // namespace

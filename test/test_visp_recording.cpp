@@ -8,7 +8,8 @@
 // simulator does not (lens distortion absent from ViSP's intrinsics: 0.3-0.55 px reprojection).
 // Through the pipeline with the default settings: calibrated within 0.2 deg of ViSP's published
 // hand-eye rotation, and the mount-change test, run as the online calibrator runs it after each new
-// pose, gives no remount verdict (the mount never moved). Skipped when the data are absent.
+// pose, gives no remount verdict (the mount never moved); without the camera's noise measured from
+// the recording, neither holds. Skipped when the data are absent.
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -59,14 +60,15 @@ struct VispOutcome {
 
 /// The recording through the pipeline (default settings), its error against ViSP's eMc, and the
 /// change test after each new pose, as the online calibrator runs it.
-bool runVisp(VispOutcome* out) {
+bool runVisp(VispOutcome* out, double camera_excess_level = JointSettings{}.camera_excess_level) {
   VispRecording rec;
   if (!loadVispRecording(kDir, &rec)) return false;
   const TargetDescription board = test::vispBoard();
   CameraIntrinsics intrinsics;
   std::string error;
   EXPECT_TRUE(test::vispIntrinsics(&intrinsics, &error)) << error;
-  const PipelineSettings settings;
+  PipelineSettings settings;
+  settings.joint.camera_excess_level = camera_excess_level;
   CalibrationPipeline pipeline(board, settings);
   EXPECT_TRUE(pipeline.setCameraIntrinsics(intrinsics));
   feedVispRecording(rec, &pipeline);
@@ -103,33 +105,39 @@ bool runVisp(VispOutcome* out) {
   return true;
 }
 
-// With the camera's covariance from the frames' scatter and a 0.01 deg floor only (before the PnP
-// covariance of the reprojection residuals, pose_assembly.cpp) this recording gave chi2/dof 111,
-// 2.03 deg from ViSP's eMc with a 1-sigma of 2.1-2.2 deg (scaled by chi2/dof), and remount
-// verdicts after 4, 5 and 6 poses. Now (measured 2026-11-26): chi2/dof 5.8, 0.42 deg with a
-// 1-sigma of [0.59 0.61 0.19] deg, no verdict through 7 poses (7: pending at pose 6), a verdict at
-// 8 (split before pose 6, 1.3 deg): see the disabled test below.
-TEST(VispRecording, CalibratedWithinItsOneSigmaAndNoRemountThroughSixPoses) {
+// History on this recording: with the camera's covariance from the frames' scatter and a 0.01 deg
+// floor only, chi2/dof 111, 2.03 deg from ViSP's eMc and remount verdicts after 4, 5 and 6 poses;
+// with each frame's PnP covariance (pose_assembly.cpp), chi2/dof 5.8, 0.42 deg (T_g and T_a
+// estimated by the likelihood ratio: they absorbed the camera's misfit, though this IMU has none)
+// and a verdict after 8 poses (1.3 deg, chi2 drop 296). The flange poses and ViSP's eMc leave
+// each rest's camera 0.3-0.65 deg off, about the optical axis too: errors of the whole pose (lens,
+// board, the arm's kinematics), not of the pixels. Measured now (JointSettings::
+// camera_excess_level: the rests' camera noise as the recording shows it, 0.31 deg per axis
+// added): T_g and T_a held at identity, 0.041 deg from ViSP's eMc with a 1-sigma of [0.13 0.14
+// 0.26] deg, no verdict after any pose (the closest: 7 poses, corrected p 5e-4 at level 1e-4).
+TEST(VispRecording, WithinTwoTenthsOfVispAndNoRemountAtAll) {
   if (!std::ifstream(kDir + "/franka_image-1.png")) GTEST_SKIP() << "no realdata at " << kDir;
   VispOutcome o;
   ASSERT_TRUE(runVisp(&o)) << "unreadable or unsolved ViSP data in " << kDir;
-  EXPECT_LT(o.error_deg, 0.5);
+  EXPECT_LT(o.error_deg, 0.2);
   EXPECT_LT(o.error_deg, 3.0 * o.result.quality.std_dev_deg.norm());
-  EXPECT_LT(o.result.joint->covariance_scale, 10.0) << "the camera's noise as the images show it";
+  EXPECT_GT(o.result.joint->camera_excess_variance_rad2, 0.0) << "real PnP's errors measured";
+  EXPECT_EQ(o.result.joint->imu_matrices, ImuMatrixModel::kIdentity)
+      << "this IMU has no scale or cross-axis errors";
   ASSERT_EQ(o.tests.size(), 5u);
-  for (size_t i = 0; i < 3; ++i) {
-    EXPECT_FALSE(o.tests[i].detected) << i + 4 << " poses: " << o.tests[i].message;
-  }
+  for (const MountChangeTest& test : o.tests) EXPECT_FALSE(test.detected) << test.message;
 }
 
-// The targets for this recording, not met yet: within 0.2 deg of ViSP (0.42) and no
-// remount verdict at all (one after 8 poses).
-TEST(VispRecording, DISABLED_WithinTwoTenthsOfVispAndNoRemountAtAll) {
+// Without the measured camera noise (camera_excess_level 0) the same recording fails both
+// targets: the test above fails without it.
+TEST(VispRecording, WithoutTheMeasuredCameraNoiseAMisfitReadsAsARemount) {
   if (!std::ifstream(kDir + "/franka_image-1.png")) GTEST_SKIP() << "no realdata at " << kDir;
   VispOutcome o;
-  ASSERT_TRUE(runVisp(&o));
-  EXPECT_LT(o.error_deg, 0.2);
-  for (const MountChangeTest& test : o.tests) EXPECT_FALSE(test.detected) << test.message;
+  ASSERT_TRUE(runVisp(&o, /*camera_excess_level=*/0.0));
+  EXPECT_GT(o.error_deg, 0.3);
+  bool detected = false;
+  for (const MountChangeTest& test : o.tests) detected = detected || test.detected;
+  EXPECT_TRUE(detected);
 }
 
 }  // namespace

@@ -24,7 +24,9 @@
 // Parameters the motion does not excite are held at their priors (joint_observability.h) and named
 // in JointResult::notes. The gyro preintegration is linearised and re-run when the gyro model moved
 // (JointResult::relinearisations). The covariance of R_cam_imu is from ceres::Covariance, scaled by
-// chi2 / dof when that exceeds 1.
+// chi2 / dof when that exceeds 1. Where the rests' camera residuals say the camera's noise exceeds
+// its stated covariance on most poses, that noise is measured and added first
+// (JointSettings::camera_excess_level).
 #pragma once
 
 #include <Eigen/Core>
@@ -47,5 +49,9 @@ class JointEstimator {
  private:
   JointSettings settings_;
 };
+
+/// Adds `variance_rad2` x I to the camera covariance of every rest with an absolute camera
+/// orientation (JointResult::camera_excess_variance_rad2 of a solve of `problem`).
+void addCameraExcessVariance(double variance_rad2, JointProblem* problem);
 
 }  // namespace camera_imu_alignment

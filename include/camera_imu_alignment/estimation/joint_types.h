@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -64,6 +65,11 @@ struct MotionFrame {
   /// The camera's centre in the target frame (m), when known (PnP, camera_pose): the velocities
   /// the acceleration model needs (JointSettings::motion_accel_link_s).
   std::optional<Eigen::Vector3d> p_target_cam_m;
+  /// The PnP fit it came from: RMS reprojection error (px) over reprojection_dof = 2 N - 6
+  /// residual coordinates (N corners); dof 0 for a given orientation (camera_pose), which has no
+  /// fit to judge (pipeline/frame_screening.h).
+  double reprojection_rms_px = 0;
+  int reprojection_dof = 0;
 };
 
 /// An unbroken stream of raw gyro samples (IMU clock, strictly increasing stamps, no gaps), with
@@ -127,6 +133,10 @@ struct JointProblem {
   /// and the gyro segment into this pose (the motion during which the mount moved) is not used.
   /// -1: one mount for all poses.
   int mount_change_pose = -1;
+  /// The same for continuous motion: the first rest or motion node at or after this stamp (camera
+  /// clock, as MotionFrame::stamp_s) has the second R_cam_imu, and the gyro into it is not used.
+  /// NaN: none. Not together with mount_change_pose.
+  double mount_change_stamp_s = std::numeric_limits<double>::quiet_NaN();
 
   /// Continuous motion (no rests needed): the camera's orientation at the frames outside the rests
   /// (stamp order) and the raw gyro over them (covering every frame's stamp plus the time offset).
@@ -225,6 +235,16 @@ struct JointSettings {
   /// MagnetometerUse::kAuto uses the magnetometer when at least this many poses have a usable
   /// field (the hard iron, 3 unknowns, then has more field directions than unknowns).
   int min_mag_poses_hard_iron = 4;
+
+  /// The camera's noise as the recording shows it. Real PnP has errors the pixel-noise
+  /// covariance does not describe (lens model, board flatness, the IMU's own reference); when the
+  /// rests' camera residuals fail their chi-square test at this level (3 dof per rest) and the
+  /// median rest is off too (a misfit of most poses, not of a remounted or bad few), an isotropic
+  /// variance is added to every rest's camera covariance, found so that the median rest's camera
+  /// chi-square is chi-square(3)'s median, and the window solved again
+  /// (JointResult::camera_excess_variance_rad2). 0: never. Only with compute_covariance (a full
+  /// solve); fits compared with each other (the mount-change test) keep one noise model.
+  double camera_excess_level = 1e-3;
 
   // Noise floors (added in quadrature to the given covariances; 1-sigma).
   double accel_mean_sigma_floor_m_s2 = 5e-4;

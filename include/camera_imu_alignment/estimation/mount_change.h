@@ -19,6 +19,13 @@
 // pose_residual_norm) above max(1.5, 2.5 x the median pose's). A pose that is merely bad leaves
 // a pose unfitted however large D is.
 //
+// The camera's noise as the recording shows it (JointSettings::camera_excess_level): real PnP's
+// errors beyond its stated covariance on every pose (ViSP's real images: 0.31 deg per axis) would
+// read as a remount of the newest poses. Each candidate measures that excess under its two-mount
+// model (the larger model's residuals, as an F test estimates the error variance: fitted with one
+// mount, a remount's misfit spreads over the whole window and would pass for noise), with the
+// model of T_g and T_a the one-mount estimate selected, and compares both fits with it added.
+//
 // Where the change is: the candidate with the largest D that fits every pose is the
 // maximum-likelihood split (first_pose_after). Candidates run up to the newest pose; those with
 // fewer than min_poses_after poses after them compete for the location but are never declared.
@@ -35,6 +42,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -51,6 +59,10 @@ struct MountChangeSettings {
   int max_poses_after = 4;
   /// Poses needed before a split.
   int min_poses_before = 2;
+  /// Continuous motion (testMountChangeOnMotion): motion needed on each side of a split (s), and
+  /// the motion left out around it (s), where the mount moved. Not setting keys.
+  double min_motion_s = 3.0;
+  double motion_gap_s = 1.0;
   /// Returns "" when usable, else the first unusable setting, named by its key.
   std::string validate() const;
 };
@@ -62,6 +74,8 @@ struct MountChangeCandidate {
   int dof = 0;               ///< dof_D
   double p_value = 1;        ///< of F, not corrected
   double scale = 1;          ///< max(1, chi2 / dof) of the two-mount fit
+  /// Camera variance added to every rest (rad^2 per axis), measured under the two-mount model.
+  double camera_excess_variance_rad2 = 0;
   /// At least min_poses_after poses after it: can be declared (else it competes for the location).
   bool declarable = false;
   double change_deg = 0;  ///< angle between the two mounts' R_cam_imu
@@ -87,6 +101,10 @@ struct MountChangeTest {
   Eigen::Matrix3d R_cam_imu_after = Eigen::Matrix3d::Identity();
   std::vector<MountChangeCandidate> candidates;
   std::string message;  ///< one line: what was found
+  /// The change during continuous motion (testMountChangeOnMotion; camera clock, s): the middle
+  /// of the motion left out; the new mount's data start motion_gap_s / 2 after it. NaN: a change
+  /// between rests (first_pose_after) or none.
+  double change_stamp_s = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Tests `problem` (its mount_change_pose ignored) against `one_mount`, the joint estimate of
@@ -94,6 +112,20 @@ struct MountChangeTest {
 MountChangeTest testMountChange(const JointProblem& problem, const JointResult& one_mount,
                                 const JointSettings& joint_settings,
                                 const MountChangeSettings& settings);
+
+/// The change test on continuous motion, for a window with too few rests for the rest test
+/// (testMountChange calls it then). Where: the one-mount estimate's motion nodes carry a camera
+/// correction (MotionFigures::node_camera_residual_rad) that steps where the mount moved (the one
+/// fit splits the difference between the mounts); the split maximising the between-sides
+/// statistic m (N - m) / N |mean_before - mean_after|^2, with min_motion_s of motion each side,
+/// locates it. Whether: the motion within motion_gap_s around it is left out and the one-mount
+/// and two-mount fits (JointProblem::mount_change_stamp_s) compared as in testMountChange (F
+/// statistic, p Bonferroni-corrected for the window's possible locations, one per gap width). A
+/// significant change within min_motion_s + motion_gap_s of either end of the motion is pending:
+/// a change in the newest seconds is located at the latest split allowed, before where it was.
+MountChangeTest testMountChangeOnMotion(const JointProblem& problem, const JointResult& one_mount,
+                                        const JointSettings& joint_settings,
+                                        const MountChangeSettings& settings);
 
 /// P(F > f) for an F(d1, d2) distribution (1 when an argument is not usable).
 double fisherUpperTail(double f, int d1, int d2);

@@ -249,6 +249,9 @@ class CalibrationPipeline : public SampleSink {
   /// Keeps the window's poses with StationaryPose::index >= `pose_index` (a remount found by
   /// index, which stays valid while newer poses arrive).
   void keepPosesFrom(int pose_index);
+  /// A mount change during continuous motion (MountChangeTest::change_stamp_s): the motion frames
+  /// before `stamp_s` (camera clock) and the rests that began before it leave the window.
+  void keepMotionFrom(double stamp_s);
   std::size_t windowSize() const;  ///< poses in the solver's window
   /// The poses in the solver's window, oldest first: the one answer to "which poses are in the
   /// window" (the snapshot, the solve, a remount's restart, --export-poses all use it).

@@ -1,8 +1,9 @@
 // Which camera frames during motion are fit for the joint estimate, judged against the recording
 // itself rather than a threshold in pixels chosen for one camera (issue 25's "frames with motion
-// blur or a poor PnP fit are dropped by their reprojection error and PnP covariance"). A proposal:
-// not yet called by the pipeline, which still refuses a frame above max_reprojection_rms_px
-// (vision/camera_pose.h); see the CHANGELOG for what wiring it in takes.
+// blur or a poor PnP fit are dropped by their reprojection error and PnP covariance"). The
+// pipeline's motion frames are judged so (screenMotionFrames, before the time offset's coarse
+// value); the setting max_reprojection_rms_px applies to them only when too few frames are there
+// to judge each other. Frames at rest keep it (vision/camera_pose.h).
 //
 // The rule works on x = log(r), r a frame's RMS reprojection error (px): a scale changes every x by
 // the same amount, so a camera with 7x the pixel error gets the same decisions. With m the median
@@ -18,6 +19,8 @@
 
 #include <string>
 #include <vector>
+
+#include "camera_imu_alignment/estimation/joint_types.h"
 
 namespace camera_imu_alignment {
 
@@ -40,5 +43,11 @@ struct FrameScreening {
 /// dropped. Fewer than 10 judged frames: all finite fits kept (no reliable median).
 FrameScreening screenFramesByReprojection(const std::vector<FrameFit>& frames,
                                           double k_sigma = 4.0);
+
+/// The motion frames of a window judged against each other (screenFramesByReprojection on their
+/// MotionFrame::reprojection_rms_px and reprojection_dof); the dropped ones are erased. Where
+/// fewer than 10 frames have a fit, those above `fallback_max_rms_px` (the setting
+/// max_reprojection_rms_px) are dropped instead: no recording to judge them by.
+FrameScreening screenMotionFrames(std::vector<MotionFrame>* frames, double fallback_max_rms_px);
 
 }  // namespace camera_imu_alignment

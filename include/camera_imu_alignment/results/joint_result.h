@@ -69,6 +69,10 @@ struct MotionFigures {
   /// accelerometer link; about 1 where the camera and the gyro agree within their noise).
   std::vector<double> node_stamps_s;
   std::vector<double> node_residual_sigma;
+  /// Per motion node (same order): its camera correction at the estimate, as
+  /// JointResult::camera_residual_rad (rad, camera axes). A mount change during the motion shows
+  /// as a step in it (mount_change.h).
+  std::vector<Eigen::Vector3d> node_camera_residual_rad;
   /// The coarse time offset's fit (coarseTimeshift, estimation/time_offset.h): candidate
   /// timeshift_cam_imu_s (s, ascending, evenly spaced) and at each the RMS difference (rad) of the
   /// camera's and the gyro's angles per frame interval.
@@ -80,6 +84,9 @@ struct MotionFigures {
   /// (motionExcitation, estimation/time_offset.h). Near 0 about an axis the motion never turned.
   Eigen::Vector3d excitation_rad = Eigen::Vector3d::Zero();
   double excitation_duration_s = 0;  ///< the frame intervals summed (s)
+  /// Motion frames dropped for a reprojection error far beyond the recording's own
+  /// (pipeline/frame_screening.h).
+  int frames_dropped = 0;
 };
 
 struct JointResult {
@@ -119,6 +126,14 @@ struct JointResult {
   /// Per pose: the magnetometer residual's squared whitened norm (chi-square with 3 dof when the
   /// model holds; robust loss not applied), 0 where the field is not used.
   std::vector<double> mag_residual_chi2;
+  /// Per pose: the camera's correction at the estimate, R_target_cam_measured^T R_target_cam_fit
+  /// as a rotation vector (rad, camera axes); zero for a pose without an absolute camera
+  /// orientation (the natural scene). Motion nodes': MotionFigures::node_camera_residual_rad.
+  std::vector<Eigen::Vector3d> camera_residual_rad;
+  /// Isotropic variance added to every rest's camera covariance (rad^2 per axis) because the
+  /// rests' camera residuals exceeded their covariances (JointSettings::camera_excess_level): the
+  /// camera's noise as the recording shows it. 0 when not.
+  double camera_excess_variance_rad2 = 0;
   /// Per JointProblem::camera_links entry: its residual's squared whitened norm (chi-square with 3
   /// dof when the model holds; robust loss not applied).
   std::vector<double> camera_link_chi2;

@@ -167,7 +167,9 @@ const std::vector<Key>& keys() {
       number<int>("min_target_points", CIA_MEMBER(detector.min_points), atLeast(4), "",
                   "fewer detected points: frame not used"),
       number<double>("max_reprojection_rms_px", CIA_MEMBER(pose.max_reprojection_rms_px), positive,
-                     "px", "PnP solutions above are rejected"),
+                     "px",
+                     "PnP solutions at rest above are rejected (motion frames: judged by the "
+                     "recording's own errors)"),
       number<double>("min_ambiguity_ratio", CIA_MEMBER(pose.min_ambiguity_ratio), positive, "",
                      "planar PnP: second solution must be this much worse"),
       number<int>("min_frames_per_pose", CIA_MEMBER(min_frames_per_pose), atLeast(1), "",

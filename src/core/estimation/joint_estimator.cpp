@@ -12,6 +12,7 @@
 #include <string>
 #include <utility>
 
+#include "camera_excess.h"
 #include "camera_imu_alignment/estimation/gyro_preintegration.h"
 #include "camera_imu_alignment/estimation/joint_observability.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
@@ -445,6 +446,45 @@ bool parseImuMatrixModel(const std::string& text, ImuMatrixModel* model) {
   return false;
 }
 
+namespace {
+
+/// The measured camera noise is re-estimated until it grows by less than this fraction.
+constexpr double kExcessSettled = 0.05;
+constexpr int kMaxExcessRounds = 4;
+
+/// The camera's measured excess noise added to the rests and the window solved again until it
+/// settles (JointSettings::camera_excess_level).
+JointResult withCameraNoiseAsMeasured(JointProblem* problem, JointResult chosen,
+                                      const Eigen::Matrix3d& R_cam_imu_initial,
+                                      const JointSettings& settings) {
+  if (!(settings.camera_excess_level > 0.0) || !settings.compute_covariance) return chosen;
+  double excess = 0.0;
+  for (int round = 0; round < kMaxExcessRounds && chosen.ok; ++round) {
+    const double more = joint::cameraExcessVariance(*problem, chosen, settings);
+    if (!(more > kExcessSettled * excess)) break;
+    JointProblem inflated = *problem;
+    addCameraExcessVariance(more, &inflated);
+    JointResult again = screenMagnetometer(inflated, R_cam_imu_initial, settings);
+    if (!again.ok) break;  // the last usable estimate stands
+    *problem = std::move(inflated);
+    excess += more;
+    chosen = std::move(again);
+  }
+  if (excess > 0.0) {
+    char buffer[240];
+    std::snprintf(buffer, sizeof(buffer),
+                  "the rests' camera orientations scatter beyond their PnP covariance: %.3f deg "
+                  "per axis added to each (the camera's noise as the recording shows it: lens "
+                  "model, intrinsics, board flatness)",
+                  rad2deg(std::sqrt(excess)));
+    chosen.notes.push_back(buffer);
+    chosen.camera_excess_variance_rad2 = excess;
+  }
+  return chosen;
+}
+
+}  // namespace
+
 JointEstimator::JointEstimator(JointSettings settings) : settings_(std::move(settings)) {}
 
 JointResult JointEstimator::solve(const JointProblem& problem,
@@ -457,7 +497,9 @@ JointResult JointEstimator::solve(const JointProblem& problem,
     return refused;
   }
   joint::ExpandedProblem expanded = joint::expandMotion(problem, settings_);
-  JointResult chosen = screenMagnetometer(expanded.problem, R_cam_imu_initial, settings_);
+  JointResult chosen = withCameraNoiseAsMeasured(
+      &expanded.problem, screenMagnetometer(expanded.problem, R_cam_imu_initial, settings_),
+      R_cam_imu_initial, settings_);
   // A motion frame's covariance is often a guess (camera_pose states none; blur and jitter grow
   // with the speed). Understated, the motion outweighs the IMU's priors and T_g's rotation, which
   // trades off with R_cam_imu without rests, absorbs the misfit (BENCHMARKS.md, BROAD): scaled.

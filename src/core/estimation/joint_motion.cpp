@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <utility>
 
@@ -153,6 +154,9 @@ std::string validateMotion(const JointProblem& problem) {
     }
     if (!frames[i].cov_cam_rad2.allFinite()) return name + ": cov_cam_rad2 is not finite";
   }
+  if (std::isfinite(problem.mount_change_stamp_s) && problem.mount_change_pose != -1) {
+    return "mount_change_stamp_s and mount_change_pose both set: one mount change at a time";
+  }
   if (frames.empty()) return "";
   const GyroStream& gyro = problem.motion_gyro;
   if (gyro.stamps_s.size() != gyro.gyro_rad_s.size()) {
@@ -238,6 +242,16 @@ ExpandedProblem expandMotion(const JointProblem& problem, const JointSettings& s
     }
     out.caller_pose.push_back(index);
   }
+  if (std::isfinite(problem.mount_change_stamp_s)) {  // the first pose at or after it, IMU clock
+    const double change_s = problem.mount_change_stamp_s + shift;
+    for (size_t k = 0; k < expanded.poses.size(); ++k) {
+      if (expanded.poses[k].start_s >= change_s) {
+        expanded.mount_change_pose = static_cast<int>(k);
+        break;
+      }
+    }
+  }
+  expanded.mount_change_stamp_s = std::numeric_limits<double>::quiet_NaN();
   for (CameraLink link : problem.camera_links) {
     // An index out of range stays invalid (-1) for validateProblem to name.
     const auto map = [&](int k) {
@@ -365,6 +379,14 @@ void mapResultToCaller(const ExpandedProblem& expanded, JointResult* result) {
       result->motion.node_residual_sigma.push_back(result->pose_residual_norm[k]);
     }
   }
+  result->motion.node_camera_residual_rad.clear();
+  if (result->camera_residual_rad.size() == expanded.caller_pose.size()) {
+    for (size_t k = 0; k < expanded.caller_pose.size(); ++k) {
+      if (expanded.caller_pose[k] < 0) {
+        result->motion.node_camera_residual_rad.push_back(result->camera_residual_rad[k]);
+      }
+    }
+  }
   const auto select = [&](auto& per_pose) {
     if (per_pose.size() != expanded.caller_pose.size()) return;
     std::remove_reference_t<decltype(per_pose)> kept;
@@ -373,6 +395,7 @@ void mapResultToCaller(const ExpandedProblem& expanded, JointResult* result) {
   };
   select(result->pose_residual_norm);
   select(result->mag_residual_chi2);
+  select(result->camera_residual_rad);
   select(result->intrinsics.gyro_bias_per_pose_rad_s);
   select(result->intrinsics.accel_bias_per_pose_m_s2);
   for (int& k : result->mag_poses_left_out) k = expanded.caller_pose[k];

@@ -76,6 +76,12 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
   Eigen::VectorXd r(16);
   result->mag_residual_chi2.assign(n, 0.0);
   result->camera_link_chi2.assign(problem.camera_links.size(), 0.0);
+  result->camera_residual_rad.assign(n, Eigen::Vector3d::Zero());
+  for (size_t k = 0; k < n; ++k) {
+    if (problem.poses[k].camera_absolute) {  // a rest's PnP or a motion node's
+      result->camera_residual_rad[k] = Eigen::Map<const Eigen::Vector3d>(state.delta[k].data());
+    }
+  }
   for (const ResidualRecord& record : built.residuals) {
     double cost = 0.0;
     r.resize(record.size);

@@ -177,6 +177,9 @@ std::string validateProblem(const JointProblem& problem, const Eigen::Matrix3d& 
            " is not a pose with poses before it (1.." + std::to_string(problem.poses.size() - 1) +
            ", or -1)";
   }
+  if (!std::isnan(problem.mount_change_stamp_s)) {  // expandMotion turns it into a pose index
+    return "mount_change_stamp_s: set without motion frames, or together with mount_change_pose";
+  }
   if (!isRotationMatrix(R_cam_imu_initial, 1e-3)) {
     return "R_cam_imu_initial is not a rotation matrix";
   }

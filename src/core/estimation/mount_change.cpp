@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "camera_excess.h"
 #include "camera_imu_alignment/estimation/joint_estimator.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 
@@ -66,11 +67,47 @@ JointProblem withFieldsOf(const JointProblem& problem, const JointResult& one_mo
   return out;
 }
 
+/// The poses before `end` and the gyro segments and camera links among them.
+JointProblem posesBefore(const JointProblem& problem, int end) {
+  JointProblem out = problem;
+  out.poses.resize(static_cast<size_t>(end));
+  out.segments.clear();
+  for (const GyroSegment& segment : problem.segments) {
+    if (segment.to_pose < end) out.segments.push_back(segment);
+  }
+  out.camera_links.clear();
+  for (const CameraLink& link : problem.camera_links) {
+    if (link.from_pose < end && link.to_pose < end) out.camera_links.push_back(link);
+  }
+  return out;
+}
+
+/// A window's camera noise beyond the stated is every pose's (real PnP), or a remount's misfit
+/// spread over the window by the one-mount fit. This level tells them apart on the poses before a
+/// split, one mount under either model: only when they show an excess of their own (chi-square
+/// test at this level and the median criterion, joint::cameraExcessVariance) is the window's
+/// excess the camera's. Loose: a remount needs only one later test to pass it.
+constexpr double kExcessBeforeLevel = 0.05;
+
+bool cameraExcessBefore(const JointProblem& problem, int split, const Eigen::Matrix3d& start,
+                        JointSettings settings) {
+  const JointProblem before = posesBefore(problem, split);
+  const JointResult fit = JointEstimator(settings).solve(before, start);
+  settings.camera_excess_level = kExcessBeforeLevel;
+  return fit.ok && joint::cameraExcessVariance(before, fit, settings) > 0.0;
+}
+
 }  // namespace
 
 MountChangeTest testMountChange(const JointProblem& problem, const JointResult& one_mount,
                                 const JointSettings& joint_settings,
                                 const MountChangeSettings& settings) {
+  const int rests = static_cast<int>(problem.poses.size());
+  if (!problem.motion_frames.empty() &&
+      rests < settings.min_poses_before + settings.min_poses_after) {
+    // Too few rests for a split between them: the change is looked for during the motion.
+    return testMountChangeOnMotion(problem, one_mount, joint_settings, settings);
+  }
   if (!problem.motion_frames.empty()) {
     // The change is tested on the rests alone: the motion during which the mount moved holds
     // nodes of both mounts that no split at a rest can assign, and their misfit would blur the
@@ -111,6 +148,7 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
   // 2 of 20 tactical recordings with a 5 deg turn). Where the selection chose identity, both
   // models are compared with the matrices estimated: the one-mount fit once more.
   JointResult reference = one_mount;
+  bool refitted = false;  // reference solved here, on the stated noise
   if (joint_settings.imu_matrices == ImuMatrixModel::kSelect &&
       one_mount.imu_matrices == ImuMatrixModel::kIdentity) {
     JointSettings estimated = two_mount_settings;
@@ -118,19 +156,51 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
     const JointResult refit = JointEstimator(estimated).solve(measured, one_mount.R_cam_imu);
     if (refit.ok && refit.dof > 0) {
       reference = refit;
+      refitted = true;
       two_mount_settings.imu_matrices = ImuMatrixModel::kEstimate;
     }
   }
   const JointEstimator estimator(two_mount_settings);
+  if (one_mount.camera_excess_variance_rad2 > 0.0 && !refitted) {
+    // Its chi-square is at the noise it measured on the whole window, a remount's misfit
+    // included: the stated noise's first (each candidate measures its own below).
+    const JointResult refit = estimator.solve(measured, one_mount.R_cam_imu);
+    if (refit.ok && refit.dof > 0) reference = refit;
+  }
   std::vector<Eigen::Matrix3d> before, after;
   int best = -1;
+  // The camera's noise as the recording shows it (JointSettings::camera_excess_level), measured
+  // per candidate under the two-mount model; where that adds any, the one-mount fit is redone on
+  // the same noise so that both fits are compared on it.
+  // The excess is measured with the model of T_g and T_a the one-mount estimate selected: where
+  // it held them at identity, the misfit they would absorb is the camera's.
+  JointSettings noise_settings = two_mount_settings;
+  noise_settings.imu_matrices = one_mount.imu_matrices;
+  const JointResult reference_stated = reference;
   for (int s = first; s < n; ++s) {
-    JointProblem split = measured;
+    JointProblem noisy = measured;
+    double excess = 0.0;
+    if (one_mount.camera_excess_variance_rad2 > 0.0 &&
+        cameraExcessBefore(measured, s, reference_stated.R_cam_imu, noise_settings)) {
+      excess = one_mount.camera_excess_variance_rad2;
+    }
+    reference = reference_stated;
+    if (excess > 0.0) {
+      addCameraExcessVariance(excess, &noisy);
+      reference = estimator.solve(noisy, reference_stated.R_cam_imu);
+      if (!reference.ok || reference.dof <= 0) {  // compared at the stated noise instead
+        reference = reference_stated;
+        noisy = measured;
+        excess = 0.0;
+      }
+    }
+    JointProblem split = noisy;
     split.mount_change_pose = s;
     const JointResult two = estimator.solve(split, reference.R_cam_imu);
     MountChangeCandidate c;
     c.first_pose_after = s;
     c.declarable = s <= last_declarable;
+    c.camera_excess_variance_rad2 = excess;
     if (two.ok && two.R_cam_imu_after_change && two.dof > 0) {
       c.solved = true;
       c.statistic = std::max(0.0, reference.chi2 - two.chi2);

@@ -1,7 +1,10 @@
 #include "camera_imu_alignment/io/joint_yaml.h"
 
+#include <cmath>
 #include <iomanip>
 #include <sstream>
+
+#include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {
 namespace {
@@ -56,6 +59,8 @@ std::string jointToYaml(const JointResult& j) {
   out << "  consistent: " << boolText(j.consistent()) << "  # chi-square p >= consistency_level\n";
   out << "  consistency_level: " << j.consistency_level << "\n";
   out << "  covariance_scale: " << j.covariance_scale << "  # chi2/dof when > 1, applied\n";
+  out << "  camera_excess_sigma_deg: " << rad2deg(std::sqrt(j.camera_excess_variance_rad2))
+      << "  # added to each rest's camera 1-sigma per axis (its noise as measured); 0: none\n";
   out << "  std_dev_deg: " << flow(j.std_dev_deg) << "  # 1-sigma about the camera x, y, z axes\n";
   out << "  data_used: " << dataUsed(j) << "  # rests, motion or both\n";
   out << "  rests: " << j.rests_used << "\n";

@@ -187,7 +187,10 @@ void drawMotionPanel(cv::Mat& img, const cv::Rect& panel, const ReportInput& in)
       report_text::fixedList(rad2deg(1.0) * m.excitation_rad, 0) + " deg" +
       (joint->motion_covariance_scale > 1.0
            ? "; motion frames' covariance scaled by " + fixed(joint->motion_covariance_scale, 1)
-           : "");
+           : "") +
+      (m.frames_dropped > 0 ? "; " + std::to_string(m.frames_dropped) +
+                                  " frame(s) dropped: reprojection far beyond the recording's"
+                            : "");
   putText(img, line, {panel.x + 10, text_y}, 0.45, kBlack, panel.width - 20);
   const std::string offset = joint->timeshift_estimated
                                  ? "timeshift_cam_imu_s (t_imu = t_cam + timeshift): " +

@@ -242,6 +242,22 @@ EstimateEvent OnlineCalibrator::Impl::judged(SolveOutput output) const {
 
 void OnlineCalibrator::Impl::applyRemount(const SolveOutput& output) {
   const MountChangeTest& test = *output.mount_test;
+  if (std::isfinite(test.change_stamp_s)) {  // during continuous motion
+    const double from_s = test.change_stamp_s + 0.5 * settings.remount.motion_gap_s;
+    pipeline->keepMotionFrom(from_s);
+    const int next_index = static_cast<int>(pipeline->poses().size());
+    char text[400];
+    std::snprintf(text, sizeof(text),
+                  "mount changed during the motion at %.2f s (by %.2f deg; chi-square change test "
+                  "p %.2g < remount_level %.2g): window restarted from the motion after %.2f s",
+                  test.change_stamp_s, test.change_deg, test.p_value, settings.remount.level,
+                  from_s);
+    const std::vector<StationaryPose> kept = pipeline->windowPoses();
+    const int first = kept.empty() ? next_index : kept.front().index;
+    restartWindowAt(first, first, test.change_deg, text);
+    motion_frames_solved = pipeline->motionFrames();  // the next solve waits for new motion
+    return;
+  }
   const int first_index = output.window.pose_indices.at(test.first_pose_after);
   const int kept_index = output.window.pose_indices.at(test.first_pose_kept);
   const std::size_t kept = static_cast<std::size_t>(

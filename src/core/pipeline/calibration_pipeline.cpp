@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -350,12 +351,18 @@ void CalibrationPipeline::Impl::processMotionFrame(const CameraFrame& frame) {
         motion_frames.empty() ? nullptr : &motion_frames.back().R_target_cam;
     TargetObservation observation;
     if (!detector.detect(frame.mono8, &observation, hint)) return;  // out of view or blurred
+    // No pixel threshold here: the window's frames are judged against each other
+    // (screenMotionFrames, when the motion is solved).
+    PoseSettings pose_settings = settings.pose;
+    pose_settings.max_reprojection_rms_px = std::numeric_limits<double>::infinity();
     std::string why;
-    const auto pose = estimateCameraPose(observation, target, *intrinsics, settings.pose, &why);
-    if (!pose) return;  // a poor fit (e.g. motion blur): dropped by the PnP checks
+    const auto pose = estimateCameraPose(observation, target, *intrinsics, pose_settings, &why);
+    if (!pose) return;  // no PnP solution
     motion.R_target_cam = pose->R_target_cam;
     motion.p_target_cam_m = pose->p_target_cam;
     motion.cov_cam_rad2 = pose->cov_rotation_rad2;
+    motion.reprojection_rms_px = pose->reprojection_rms_px;
+    motion.reprojection_dof = 2 * pose->num_points - 6;
   }
   last_motion_frame_stamp = frame.stamp_s;
   motion_frames.push_back(motion);
@@ -380,6 +387,20 @@ ImuOrientationSource CalibrationPipeline::imuOrientationSource() const {
 }
 
 void CalibrationPipeline::keepPosesFrom(int pose_index) { impl_->window.keepFrom(pose_index); }
+
+void CalibrationPipeline::keepMotionFrom(double stamp_s) {
+  int first_kept = static_cast<int>(impl_->poses.size());  // the next pose's index
+  for (const StationaryPose& pose : impl_->window.poses()) {
+    if (pose.start_s >= stamp_s) {
+      first_kept = pose.index;
+      break;
+    }
+  }
+  impl_->window.keepFrom(first_kept);
+  while (!impl_->motion_frames.empty() && impl_->motion_frames.front().stamp_s < stamp_s) {
+    impl_->motion_frames.pop_front();
+  }
+}
 
 std::vector<StationaryPose> CalibrationPipeline::windowPoses() const {
   return impl_->window.poses();

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 namespace camera_imu_alignment {
 namespace {
@@ -64,6 +65,42 @@ FrameScreening screenFramesByReprojection(const std::vector<FrameFit>& frames, d
                   out.dropped, judged_count, out.typical_rms_px, worst_rms);
     out.note = buffer;
   }
+  return out;
+}
+
+FrameScreening screenMotionFrames(std::vector<MotionFrame>* frames, double fallback_max_rms_px) {
+  std::vector<FrameFit> fits;
+  std::size_t judged_count = 0;
+  for (const MotionFrame& frame : *frames) {
+    fits.push_back({frame.reprojection_rms_px, frame.reprojection_dof});
+    if (judged(fits.back())) ++judged_count;
+  }
+  FrameScreening out = screenFramesByReprojection(fits);
+  if (judged_count > 0 && judged_count < kMinJudged) {
+    out.keep.assign(fits.size(), true);
+    out.dropped = 0;
+    for (std::size_t k = 0; k < fits.size(); ++k) {
+      if (judged(fits[k]) &&
+          !(usable(fits[k]) && fits[k].reprojection_rms_px <= fallback_max_rms_px)) {
+        out.keep[k] = false;
+        ++out.dropped;
+      }
+    }
+    out.note.clear();
+    if (out.dropped > 0) {
+      char buffer[200];
+      std::snprintf(buffer, sizeof(buffer),
+                    "%d of %zu frames dropped: reprojection above max_reprojection_rms_px (%.3g "
+                    "px; too few frames to judge them by each other)",
+                    out.dropped, judged_count, fallback_max_rms_px);
+      out.note = buffer;
+    }
+  }
+  std::vector<MotionFrame> kept;
+  for (std::size_t k = 0; k < frames->size(); ++k) {
+    if (out.keep[k]) kept.push_back((*frames)[k]);
+  }
+  *frames = std::move(kept);
   return out;
 }
 

@@ -7,6 +7,7 @@
 #include "calibration_pipeline_impl.h"
 #include "camera_imu_alignment/estimation/gyro_preintegration.h"
 #include "camera_imu_alignment/estimation/time_offset.h"
+#include "camera_imu_alignment/pipeline/frame_screening.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {
@@ -41,6 +42,15 @@ void CalibrationPipeline::Impl::addMotion(double from_s, JointProblem* problem) 
 std::string prepareMotion(const PipelineSettings& settings, WindowSnapshot* window,
                           MotionFigures* figures) {
   JointProblem& joint = window->joint;
+  // Frames whose fit is far beyond the recording's own (a misdetected corner, a blurred board):
+  // dropped before they can bend the time offset or the estimate.
+  const FrameScreening screening =
+      screenMotionFrames(&joint.motion_frames, settings.pose.max_reprojection_rms_px);
+  figures->frames_dropped = screening.dropped;
+  if (joint.motion_frames.empty()) {
+    joint.motion_gyro = GyroStream{};
+    return screening.note + " (no motion frames left)";
+  }
   const TimeshiftSearch coarse =
       coarseTimeshift(joint.motion_frames, joint.motion_gyro, settings.max_timeshift_s);
   // The report's figures of the motion (JointResult::motion), once, from the data solved on.
@@ -65,7 +75,8 @@ std::string prepareMotion(const PipelineSettings& settings, WindowSnapshot* wind
                 "%zu frames; timeshift_cam_imu %.1f ms from the angular speeds (+-%.3f s searched)",
                 joint.motion_frames.size(), 1e3 * coarse.timeshift_cam_imu_s,
                 settings.max_timeshift_s);
-  if (!window->pairs.empty()) return buffer;
+  const std::string said = screening.note.empty() ? buffer : buffer + ("; " + screening.note);
+  if (!window->pairs.empty()) return said;
   // No rest pairs: pairs of motion frames (camera relative rotation, gyro over the shifted
   // interval with the ideal gyro and no bias) for the pair solvers.
   const std::vector<MotionFrame>& frames = joint.motion_frames;
@@ -90,7 +101,7 @@ std::string prepareMotion(const PipelineSettings& settings, WindowSnapshot* wind
     }
     from = k;
   }
-  return buffer;
+  return said;
 }
 
 }  // namespace camera_imu_alignment

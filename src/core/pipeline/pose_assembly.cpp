@@ -429,6 +429,7 @@ AlignmentResult solveWindow(const WindowSnapshot& window_in, const PipelineSetti
   if (joint.motion_nodes > 0) {  // the estimator's per-node residuals, the pipeline's curve
     motion_figures.node_stamps_s = joint.motion.node_stamps_s;
     motion_figures.node_residual_sigma = joint.motion.node_residual_sigma;
+    motion_figures.node_camera_residual_rad = joint.motion.node_camera_residual_rad;
     result.joint->motion = std::move(motion_figures);
   }
   return result;

@@ -1,0 +1,21 @@
+// The camera's noise as the recording shows it (JointSettings::camera_excess_level): the
+// isotropic variance real PnP errors add to the rests' stated camera covariances.
+#pragma once
+
+#include "camera_imu_alignment/estimation/joint_types.h"
+
+namespace camera_imu_alignment {
+namespace joint {
+
+/// The isotropic variance (rad^2) that, added to every rest's camera covariance, brings the
+/// median rest's camera chi-square to chi-square(3)'s median; 0 when the rests' camera residuals
+/// (result.camera_residual_rad, of a solve of `problem`) pass their chi-square test at
+/// settings.camera_excess_level, or when the median rest already fits (the misfit is a few
+/// poses': a remount or a bad pose, which the mount-change test judges).
+/// With `tested` false the chi-square test is skipped (the median criterion alone): for a caller
+/// that already knows the window as a whole shows an excess and measures it on part of it.
+double cameraExcessVariance(const JointProblem& problem, const JointResult& result,
+                            const JointSettings& settings, bool tested = true);
+
+}  // namespace joint
+}  // namespace camera_imu_alignment
