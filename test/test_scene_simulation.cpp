@@ -255,6 +255,64 @@ TEST(SceneTrajectory, HandheldRestsMeetTheirSpecification) {
   }
 }
 
+TEST(SceneTrajectory, ARobotsRemountTurnsTheImuAloneDuringOneDrive) {
+  // The room scenarios take the board scenarios' remount (SimulationConfig::remount): the same
+  // stops (so the same images), the IMU turned by Exp(v) during the drive into stop n/2 (the
+  // default time), seen by the gyro, and the truth file records it.
+  sim::SimulationConfig plain = roomConfig("room_robot", 3);
+  plain.num_poses = 6;
+  plain.noise_scale = 0.0;
+  sim::SimulationConfig remounted = plain;
+  remounted.remount = true;
+  remounted.remount_rotvec_cam = Eigen::Vector3d(0.0, 2.0, 0.0) * test::kPiTest / 180.0;
+  const sim::SimulationRun a(plain), b(remounted);
+  const auto& stops = b.trajectory.poses();
+  ASSERT_EQ(stops.size(), a.trajectory.poses().size());
+  for (size_t k = 0; k < stops.size(); ++k) {
+    EXPECT_EQ(stops[k].R_world_cam, a.trajectory.poses()[k].R_world_cam) << "stop " << k;
+    EXPECT_EQ(stops[k].p_world_cam, a.trajectory.poses()[k].p_world_cam) << "stop " << k;
+    EXPECT_EQ(stops[k].start_s, a.trajectory.poses()[k].start_s) << "stop " << k;
+  }
+  // The 1 s change lies inside the drive from stop 2 to stop 3.
+  const double t_remount = b.trajectory.remountTime();
+  EXPECT_GT(t_remount - 0.5, stops[2].end_s);
+  EXPECT_LT(t_remount + 0.5, stops[3].start_s);
+  const Eigen::Matrix3d turn = axisAngle(Eigen::Vector3d::UnitY(), 2.0 * test::kPiTest / 180.0);
+  EXPECT_LT(test::angleBetweenDeg(b.trajectory.R_cam_imu_final(),
+                                  turn * b.trajectory.R_cam_imu_initial()),
+            1e-9);
+  for (size_t k = 0; k < stops.size(); ++k) {
+    const double t = 0.5 * (stops[k].start_s + stops[k].end_s);
+    const Eigen::Matrix3d mount =
+        k < 3 ? b.trajectory.R_cam_imu_initial() : b.trajectory.R_cam_imu_final();
+    EXPECT_LT(test::angleBetweenDeg(b.trajectory.at(t).R_world_imu(), stops[k].R_world_cam * mount),
+              1e-9)
+        << "stop " << k;
+  }
+  // The noise-free gyro from the first stop to the last: the IMU's own turn, remount included.
+  Eigen::Matrix3d gyro = Eigen::Matrix3d::Identity();
+  const double ta = stops.front().end_s, tb = stops.back().start_s;
+  for (size_t i = 0; i + 1 < b.imu.size(); ++i) {
+    if (b.imu[i].t < ta || b.imu[i + 1].t > tb) continue;
+    const Eigen::Vector3d w =
+        0.5 * (b.imu[i].gyro - b.imu[i].gyro_bias + b.imu[i + 1].gyro - b.imu[i + 1].gyro_bias);
+    gyro = gyro * test::rotationFromVector(w * (b.imu[i + 1].t - b.imu[i].t));
+  }
+  const Eigen::Matrix3d imu_turn =
+      b.trajectory.at(ta).R_world_imu().transpose() * b.trajectory.at(tb).R_world_imu();
+  EXPECT_LT(test::angleBetweenDeg(gyro, imu_turn), 0.02);
+  const Eigen::Matrix3d camera_turn =
+      stops.front().R_world_cam.transpose() * stops.back().R_world_cam;
+  const Eigen::Matrix3d one_mount =
+      b.trajectory.R_cam_imu_initial().transpose() * camera_turn * b.trajectory.R_cam_imu_initial();
+  EXPECT_NEAR(test::angleBetweenDeg(gyro, one_mount), 2.0, 0.02) << "the gyro sees the remount";
+  const YAML::Node truth = YAML::Load(sim::truthYaml(b));
+  EXPECT_TRUE(truth["remount"]["enabled"].as<bool>());
+  EXPECT_NEAR(truth["remount"]["time_s"].as<double>(), remounted.start_time_s + t_remount, 1e-6);
+  EXPECT_TRUE(truth["remount"]["R_cam_imu_before"]["quaternion_xyzw"]);
+  EXPECT_FALSE(YAML::Load(sim::truthYaml(a))["remount"]["enabled"].as<bool>());
+}
+
 TEST(SceneTrajectory, MovingObjectsAreInViewAndMoveDuringTheRests) {
   for (const char* scenario : {"room_robot", "room_handheld"}) {
     sim::SimulationConfig config = roomConfig(scenario, 2);

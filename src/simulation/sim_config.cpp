@@ -40,11 +40,12 @@ const std::vector<std::pair<std::string, std::string>>& scenarioList() {
       {"room_robot",
        "no board: a ground robot in a textured 6 x 5 m room with boxes, camera ~0.4 m high; 12 "
        "stops of 3-5 s, 0.3-2 m apart, turning 10-60 deg, tilted 5-20 deg by uneven ground, "
-       "consecutive views overlapping (any --imu-grade; --moving-objects, --texture-poor)"},
+       "consecutive views overlapping (any --imu-grade; --moving-objects, --texture-poor, "
+       "--remount)"},
       {"room_handheld",
        "no board: a hand-held rig in the textured room, 12 rests of 3-5 s turned 20-60 deg about "
        "all axes, small translations, walls and boxes 1-3 m away, consecutive views overlapping "
-       "(any --imu-grade; --moving-objects, --texture-poor)"},
+       "(any --imu-grade; --moving-objects, --texture-poor, --remount)"},
   };
   return list;
 }

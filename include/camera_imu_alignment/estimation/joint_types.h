@@ -130,8 +130,9 @@ struct JointProblem {
   std::vector<CameraLink> camera_links;
   /// A mount change (the change-point model of mount_change.h): poses from this index on have
   /// their own R_cam_imu (JointResult::R_cam_imu_after_change), the IMU's parameters stay shared,
-  /// and the gyro segment into this pose (the motion during which the mount moved) is not used.
-  /// -1: one mount for all poses.
+  /// and the gyro segment into this pose (the motion during which the mount moved) measures the
+  /// IMU's turn from the first mount's orientation to the second's (the IMU turned so whenever the
+  /// mount moved; a segment into a motion node there is left out). -1: one mount for all poses.
   int mount_change_pose = -1;
   /// The same for continuous motion: the first rest or motion node at or after this stamp (camera
   /// clock, as MotionFrame::stamp_s) has the second R_cam_imu, and the gyro into it is not used.

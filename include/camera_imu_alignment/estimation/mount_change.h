@@ -4,10 +4,12 @@
 // For each candidate s (the newest poses only: a change is looked for as the poses after it
 // arrive) the joint estimator solves the two-mount model (JointProblem::mount_change_pose = s:
 // a second R_cam_imu for poses s.., the IMU's parameters shared, the gyro motion into pose s
-// unused). The statistic is the drop of the chi-square,
+// the IMU's turn from the first mount to the second). The statistic is the drop of the chi-square,
 //   D(s) = chi2(one mount) - chi2(two mounts, split at s),
-// which without a change is chi-square distributed with dof(one) - dof(two) degrees of freedom
-// (3 for the second rotation + 3 for the gyro motion left out). Both fits have the same model of
+// which without a change is chi-square distributed with dof(one) - dof(two) = 3 degrees of
+// freedom (the second rotation). The gyro motion into pose s was once left out (3 more dof): it
+// then left the second mount's rotation about the vertical to a weak prior where the poses after
+// turn about the vertical only and no magnetometer is used. Both fits have the same model of
 // T_g and T_a: the one-mount estimate's, except that where its model selection held them at
 // identity (ImuMatrixModel::kSelect) both are fitted with them estimated, since a window that
 // mixes two mounts can make the selection drop matrices the unit needs. It is judged as an F
@@ -108,7 +110,10 @@ struct MountChangeTest {
 };
 
 /// Tests `problem` (its mount_change_pose ignored) against `one_mount`, the joint estimate of
-/// the same problem with one mount (must be ok).
+/// the same problem with one mount (must be ok; with camera links, screened as
+/// solveScreeningCameraLinks does, camera_link_screening.h). With camera links (the natural
+/// scene) every two-mount fit screens them on its own, and the chi-square values compared are
+/// trimmed: a link left out counts at the outlier level (trimmedChi2, trimmedDof).
 MountChangeTest testMountChange(const JointProblem& problem, const JointResult& one_mount,
                                 const JointSettings& joint_settings,
                                 const MountChangeSettings& settings);

@@ -135,8 +135,13 @@ struct JointResult {
   /// camera's noise as the recording shows it. 0 when not.
   double camera_excess_variance_rad2 = 0;
   /// Per JointProblem::camera_links entry: its residual's squared whitened norm (chi-square with 3
-  /// dof when the model holds; robust loss not applied).
+  /// dof when the model holds; robust loss not applied). For a link left out (below), its value in
+  /// the solve that left it out.
   std::vector<double> camera_link_chi2;
+  /// Camera links (indices into JointProblem::camera_links) this estimate left out as outliers
+  /// (the pipeline's screening of natural-scene rotations): a comparison of models on the same
+  /// measurements (the mount-change test) leaves them out too. Sorted.
+  std::vector<int> camera_links_left_out;
   /// Poses whose field was left out as disturbed: it did not fit the calibrated iron and field.
   std::vector<int> mag_poses_left_out;
   /// The camera-IMU time offset (Kalibr's timeshift_cam_imu: t_imu = t_cam + timeshift; s) and

@@ -301,8 +301,12 @@ class Builder {
     for (size_t j = 0; j < problem_.segments.size(); ++j) {
       const GyroSegment& segment = problem_.segments[j];
       const int from = segment.from_pose, to = segment.to_pose;
-      // The mount moved during this motion: the camera and the IMU rotated differently.
-      if (afterChange(static_cast<size_t>(to)) && !afterChange(static_cast<size_t>(from))) continue;
+      // The mount moved during this motion: the gyro measured the IMU's turn from the first
+      // mount's orientation to the second's (below); a motion node's segment is left out (the
+      // mount-change test solves the rests alone).
+      const bool across_change =
+          afterChange(static_cast<size_t>(to)) && !afterChange(static_cast<size_t>(from));
+      if (across_change && segment.interval) continue;
       GyroModelVector theta0_minus_identity = gyro[j].theta0;
       theta0_minus_identity(0) -= 1.0;
       theta0_minus_identity(4) -= 1.0;
@@ -313,6 +317,17 @@ class Builder {
       GyroResidual residual{quaternionOf(camera_relative), quaternionOf(cameraImu0(from)),
                             quaternionOf(gyro[j].delta_R), gyro[j].jacobian,
                             theta0_minus_identity,         whitening_.gyro_relative[j]};
+      if (across_change) {
+        residual.q_X0_to = quaternionOf(cameraImu0(static_cast<size_t>(to)));
+        auto* cost = new ceres::AutoDiffCostFunction<ChangeGyroResidual, 3, 3, 3, 3, 3, 9, 3, 3>(
+            new ChangeGyroResidual{residual});
+        record(ceres_.AddResidualBlock(cost, loss_, cameraImuIncrement(from),
+                                       cameraImuIncrement(to), state_.delta[from].data(),
+                                       state_.delta[to].data(), state_.gyro_matrix.data(),
+                                       state_.gyro_bias[from].data(), state_.gyro_bias[to].data()),
+               from, to, 3);
+        continue;
+      }
       if (segment.interval) {
         residual.rate_from = rates_from[j];
         residual.rate_to = rates_to[j];

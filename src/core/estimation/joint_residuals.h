@@ -162,23 +162,33 @@ struct GyroResidual {
   // Motion nodes (MotionGyroResidual): the calibrated body rates at the ends, rad/s, IMU frame.
   Eigen::Vector3d rate_from = Eigen::Vector3d::Zero(), rate_to = Eigen::Vector3d::Zero();
   double timeshift0 = 0;  // s, the preintegration's time offset
+  /// ChangeGyroResidual: the second mount's linearisation point (pose k+1's R_cam_imu).
+  std::array<double, 4> q_X0_to{1.0, 0.0, 0.0, 0.0};
 
   template <typename T>
   bool operator()(const T* e_X, const T* delta_from, const T* delta_to, const T* gyro_matrix,
                   const T* bias_from, const T* bias_to, T* residual) const {
-    return evaluate<T, false>(e_X, delta_from, delta_to, gyro_matrix, bias_from, bias_to, nullptr,
-                              residual);
+    return evaluate<T, false>(e_X, nullptr, delta_from, delta_to, gyro_matrix, bias_from, bias_to,
+                              nullptr, residual);
   }
 
   /// With kShifted, the ends at motion nodes move with the time offset: the gyro's rotation
-  /// becomes Exp(-rate_from dt) DeltaR Exp(rate_to dt), dt = timeshift - timeshift0.
+  /// becomes Exp(-rate_from dt) DeltaR Exp(rate_to dt), dt = timeshift - timeshift0. With e_X_to
+  /// (not null), pose k+1 has a mount of its own: Exp(e_X_to) q_X0_to.
   template <typename T, bool kShifted>
-  bool evaluate(const T* e_X, const T* delta_from, const T* delta_to, const T* gyro_matrix,
-                const T* bias_from, const T* bias_to, const T* timeshift, T* residual) const {
+  bool evaluate(const T* e_X, const T* e_X_to, const T* delta_from, const T* delta_to,
+                const T* gyro_matrix, const T* bias_from, const T* bias_to, const T* timeshift,
+                T* residual) const {
     T q_e[4], q_X[4], q_X_inverse[4], q_from[4], q_to[4], a[4], b[4];
     const T q_X0_t[4] = {T(q_X0[0]), T(q_X0[1]), T(q_X0[2]), T(q_X0[3])};
     ceres::AngleAxisToQuaternion(e_X, q_e);
     multiply(q_e, q_X0_t, q_X);
+    T q_X_to[4] = {q_X[0], q_X[1], q_X[2], q_X[3]};
+    if (e_X_to != nullptr) {
+      const T q_X0_to_t[4] = {T(q_X0_to[0]), T(q_X0_to[1]), T(q_X0_to[2]), T(q_X0_to[3])};
+      ceres::AngleAxisToQuaternion(e_X_to, q_e);
+      multiply(q_e, q_X0_to_t, q_X_to);
+    }
     q_X_inverse[0] = q_X[0];
     for (int i = 1; i < 4; ++i) q_X_inverse[i] = -q_X[i];
     const T minus_delta_from[3] = {-delta_from[0], -delta_from[1], -delta_from[2]};
@@ -186,12 +196,12 @@ struct GyroResidual {
     ceres::AngleAxisToQuaternion(delta_to, q_to);
     const T q_A[4] = {T(q_camera_relative[0]), T(q_camera_relative[1]), T(q_camera_relative[2]),
                       T(q_camera_relative[3])};
-    // imu_relative = X^T Exp(-delta_from) A Exp(delta_to) X
+    // imu_relative = X^T Exp(-delta_from) A Exp(delta_to) X_to (X_to = X with one mount)
     multiply(q_X_inverse, q_from, a);
     multiply(a, q_A, b);
     multiply(b, q_to, a);
     T q_imu_relative[4];
-    multiply(a, q_X, q_imu_relative);
+    multiply(a, q_X_to, q_imu_relative);
 
     Eigen::Matrix<T, kGyroModelSize, 1> dtheta;
     for (int i = 0; i < 9; ++i) dtheta(i) = gyro_matrix[i] - T(theta0_minus_identity(i));
@@ -235,8 +245,23 @@ struct MotionGyroResidual {
   template <typename T>
   bool operator()(const T* e_X, const T* delta_from, const T* delta_to, const T* gyro_matrix,
                   const T* bias_from, const T* bias_to, const T* timeshift, T* residual) const {
-    return gyro.evaluate<T, true>(e_X, delta_from, delta_to, gyro_matrix, bias_from, bias_to,
-                                  timeshift, residual);
+    return gyro.evaluate<T, true>(e_X, nullptr, delta_from, delta_to, gyro_matrix, bias_from,
+                                  bias_to, timeshift, residual);
+  }
+};
+
+/// GyroResidual of the motion during which the mount changed (JointProblem::mount_change_pose):
+/// the gyro measures the IMU's turn whenever the mount moved, from the first mount's orientation
+/// at the rest before to the second's at the rest after: X^T Exp(-delta_from) A Exp(delta_to)
+/// X_after.
+struct ChangeGyroResidual {
+  GyroResidual gyro;  ///< with q_X0_to the second mount's
+
+  template <typename T>
+  bool operator()(const T* e_X, const T* e_X_after, const T* delta_from, const T* delta_to,
+                  const T* gyro_matrix, const T* bias_from, const T* bias_to, T* residual) const {
+    return gyro.evaluate<T, false>(e_X, e_X_after, delta_from, delta_to, gyro_matrix, bias_from,
+                                   bias_to, nullptr, residual);
   }
 };
 

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "camera_excess.h"
+#include "camera_imu_alignment/estimation/camera_link_screening.h"
 #include "camera_imu_alignment/estimation/joint_estimator.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 
@@ -116,7 +117,8 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
     JointProblem rests = problem;
     rests.motion_frames.clear();
     rests.motion_gyro = GyroStream{};
-    const JointResult rests_one = JointEstimator(joint_settings).solve(rests, one_mount.R_cam_imu);
+    const JointResult rests_one =
+        solveScreeningCameraLinks(JointEstimator(joint_settings), rests, one_mount.R_cam_imu);
     return testMountChange(rests, rests_one, joint_settings, settings);
   }
   MountChangeTest test;
@@ -153,7 +155,8 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
       one_mount.imu_matrices == ImuMatrixModel::kIdentity) {
     JointSettings estimated = two_mount_settings;
     estimated.imu_matrices = ImuMatrixModel::kEstimate;
-    const JointResult refit = JointEstimator(estimated).solve(measured, one_mount.R_cam_imu);
+    const JointResult refit =
+        solveScreeningCameraLinks(JointEstimator(estimated), measured, one_mount.R_cam_imu);
     if (refit.ok && refit.dof > 0) {
       reference = refit;
       refitted = true;
@@ -164,7 +167,7 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
   if (one_mount.camera_excess_variance_rad2 > 0.0 && !refitted) {
     // Its chi-square is at the noise it measured on the whole window, a remount's misfit
     // included: the stated noise's first (each candidate measures its own below).
-    const JointResult refit = estimator.solve(measured, one_mount.R_cam_imu);
+    const JointResult refit = solveScreeningCameraLinks(estimator, measured, one_mount.R_cam_imu);
     if (refit.ok && refit.dof > 0) reference = refit;
   }
   std::vector<Eigen::Matrix3d> before, after;
@@ -187,26 +190,31 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
     reference = reference_stated;
     if (excess > 0.0) {
       addCameraExcessVariance(excess, &noisy);
-      reference = estimator.solve(noisy, reference_stated.R_cam_imu);
+      reference = solveScreeningCameraLinks(estimator, noisy, reference_stated.R_cam_imu);
       if (!reference.ok || reference.dof <= 0) {  // compared at the stated noise instead
         reference = reference_stated;
         noisy = measured;
         excess = 0.0;
       }
     }
+    // Natural-scene rotations screened in each model on its own, those left out counted at the
+    // outlier level (camera_link_screening.h): a remount about a robot's vertical shows only in
+    // the rotations across it, which the one-mount fit leaves out as outliers.
     JointProblem split = noisy;
     split.mount_change_pose = s;
-    const JointResult two = estimator.solve(split, reference.R_cam_imu);
+    const JointResult two = solveScreeningCameraLinks(estimator, split, reference.R_cam_imu);
+    const int two_dof = trimmedDof(two);
+    const double two_chi2 = trimmedChi2(two);
     MountChangeCandidate c;
     c.first_pose_after = s;
     c.declarable = s <= last_declarable;
     c.camera_excess_variance_rad2 = excess;
-    if (two.ok && two.R_cam_imu_after_change && two.dof > 0) {
+    if (two.ok && two.R_cam_imu_after_change && two_dof > 0) {
       c.solved = true;
-      c.statistic = std::max(0.0, reference.chi2 - two.chi2);
-      c.dof = reference.dof - two.dof;
-      c.scale = std::max(1.0, two.chi2 / two.dof);
-      c.p_value = fisherUpperTail(c.statistic / std::max(1, c.dof) / c.scale, c.dof, two.dof);
+      c.statistic = std::max(0.0, trimmedChi2(reference) - two_chi2);
+      c.dof = trimmedDof(reference) - two_dof;
+      c.scale = std::max(1.0, two_chi2 / two_dof);
+      c.p_value = fisherUpperTail(c.statistic / std::max(1, c.dof) / c.scale, c.dof, two_dof);
       c.change_deg =
           rad2deg(rotationAngle(two.R_cam_imu.transpose() * *two.R_cam_imu_after_change));
       c.worst_pose_misfit = worstPoseMisfit(two.pose_residual_norm);

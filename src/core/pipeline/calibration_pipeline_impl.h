@@ -54,13 +54,6 @@ struct SegmentField {
 std::string prepareMotion(const PipelineSettings& settings, WindowSnapshot* window,
                           MotionFigures* figures);
 
-/// The joint estimate of a window with natural-scene rotations (scene_assembly.cpp): a wrong
-/// rotation between two views (a near-planar view's two-fold ambiguity, repeated texture) stands
-/// out by its residual; the worst one beyond the chi-square(3) tail of kSceneLinkOutlierLevel is
-/// left out and the window solved again, at most a third of the links. `dropped`: how many.
-JointResult solveJointScreeningSceneLinks(JointProblem problem, const Eigen::Matrix3d& R_start,
-                                          const JointSettings& settings, int* dropped);
-
 struct CalibrationPipeline::Impl {
   Impl(const TargetDescription& target, const PipelineSettings& settings,
        PipelineCallbacks callbacks);

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "calibration_pipeline_impl.h"
+#include "camera_imu_alignment/estimation/camera_link_screening.h"
 #include "camera_imu_alignment/estimation/joint_estimator.h"
 #include "camera_imu_alignment/solver/rotation_average.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
@@ -391,9 +392,10 @@ AlignmentResult solveWindow(const WindowSnapshot& window_in, const PipelineSetti
     return result;
   }
   // The joint estimate, started from the pair solve.
-  int links_dropped = 0;
-  const JointResult joint = solveJointScreeningSceneLinks(
-      window.joint, result.R_cam_imu, jointSettingsOf(settings), &links_dropped);
+  // Natural-scene rotations screened: a wrong one is left out (camera_link_screening.h).
+  const JointResult joint = solveScreeningCameraLinks(JointEstimator(jointSettingsOf(settings)),
+                                                      window.joint, result.R_cam_imu);
+  const std::size_t links_dropped = joint.camera_links_left_out.size();
   const std::string sensors = settings.imu_orientation == ImuOrientationSource::kMagnetometer
                                   ? " (camera, accelerometer, magnetometer; gyro not used)"
                                   : "";

@@ -28,31 +28,7 @@ double rmsSigmaDeg(const Eigen::Matrix3d& cov_rad2) {
   return rad2deg(std::sqrt(std::max(0.0, cov_rad2.trace()) / 3.0));
 }
 
-/// Chi-square(3) upper-tail level beyond which a natural-scene rotation is an outlier.
-constexpr double kSceneLinkOutlierChi2 = 21.108;  // chi-square(3) at p = 1e-4
-
 }  // namespace
-
-JointResult solveJointScreeningSceneLinks(JointProblem problem, const Eigen::Matrix3d& R_start,
-                                          const JointSettings& settings, int* dropped) {
-  *dropped = 0;
-  const JointEstimator estimator(settings);
-  JointResult joint = estimator.solve(problem, R_start);
-  const int max_dropped = static_cast<int>(problem.camera_links.size()) / 3;
-  while (joint.ok && *dropped < max_dropped &&
-         joint.camera_link_chi2.size() == problem.camera_links.size()) {
-    const auto worst =
-        std::max_element(joint.camera_link_chi2.begin(), joint.camera_link_chi2.end());
-    if (worst == joint.camera_link_chi2.end() || *worst < kSceneLinkOutlierChi2) break;
-    problem.camera_links.erase(problem.camera_links.begin() +
-                               (worst - joint.camera_link_chi2.begin()));
-    JointResult again = estimator.solve(problem, joint.R_cam_imu);
-    if (!again.ok) break;
-    joint = std::move(again);
-    ++*dropped;
-  }
-  return joint;
-}
 
 void CalibrationPipeline::Impl::keepSceneCandidate(const CameraFrame& frame) {
   // Which frame is the sharpest inside the rest is known only when the rest ends (its margins):
