@@ -189,9 +189,10 @@ int main(int argc, char** argv) {
   std::printf("|---|---|---|---|---|\n");
   for (const auto& [name, col] :
        {std::make_pair("held (static)", &fixed), std::make_pair("sliding", &moving)}) {
-    std::printf("| %s | %d / %d | %.3f deg | %d / %d | %ld of %ld (%.1f %%) |\n", name,
-                col->consistent, col->seeds, col->rms(), col->within, col->consistent,
-                col->rejected, col->matches,
+    char rms[32] = "-";  // none consistent: no RMS
+    if (col->consistent > 0) std::snprintf(rms, sizeof(rms), "%.3f deg", col->rms());
+    std::printf("| %s | %d / %d | %s | %d / %d | %ld of %ld (%.1f %%) |\n", name, col->consistent,
+                col->seeds, rms, col->within, col->consistent, col->rejected, col->matches,
                 col->matches ? 100.0 * col->rejected / col->matches : 0.0);
   }
   return 0;
