@@ -38,7 +38,7 @@ namespace simulation {
 constexpr double kRobotCameraPitchDeg = 8.0;  ///< robot camera's optical axis below the base's x
 constexpr double kMinViewOverlap = 0.3;       ///< of the sample rays, seen from both rests
 constexpr double kMovingShareMin = 0.1;       ///< with moving objects: share of each rest's view
-constexpr double kMovingShareMax = 0.5;       ///< on the sliding boxes
+constexpr double kMovingShareMax = 0.25;  ///< on the sliding boxes (issue 26: 20 % of the features)
 constexpr int kMaxCandidates = 4000;
 
 /// R_base_cam of the robot (base: x forward, y left, z up).
