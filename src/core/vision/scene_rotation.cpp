@@ -11,6 +11,7 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
+#include <tuple>
 #include <utility>
 
 #include "camera_imu_alignment/solver/rotation_math.h"
@@ -111,11 +112,16 @@ SceneFeatures extractSceneFeatures(const cv::Mat& mono8, const CameraIntrinsics&
   cv::Mat descriptors;
   sift->detectAndCompute(sift_image, cv::noArray(), keypoints, descriptors);
   if (keypoints.empty()) return features;
-  // SIFT keeps ties at the response cut: at most max_features, the strongest.
+  // SIFT keeps ties at the response cut: at most max_features, the strongest. Its keypoints come
+  // in an order its threads decide, and the order feeds the matching and RANSAC: sorted fully
+  // (response, then position, size and angle), the same image gives the same rotation in any run.
   std::vector<int> order(keypoints.size());
   std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(),
-                   [&](int a, int b) { return keypoints[a].response > keypoints[b].response; });
+  const auto key = [&](int i) {
+    const cv::KeyPoint& k = keypoints[i];
+    return std::make_tuple(-k.response, k.pt.x, k.pt.y, k.size, k.angle, k.octave);
+  };
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
   order.resize(std::min<size_t>(order.size(), settings.max_features));
   std::vector<cv::Point2f> pixels;
   // Into the full image's pixels (centres at integer coordinates in both images).
