@@ -130,6 +130,10 @@ TEST(CalibrationSnapshot, WindowIsWhatTheEstimateUsedAndProgressReachesTheTarget
   const int n = static_cast<int>(short_of.latest->window_poses);
   // (sigma / max)^2 = 4 (same estimate): three times the window's poses more.
   EXPECT_NEAR(short_of.progress.poses_needed, 3 * n, 1);
+  // How to move, from the axis and the newest rest's vertical: said in the progress line.
+  EXPECT_FALSE(short_of.progress.how_to_move.empty());
+  EXPECT_NE(progressText(short_of.progress).find(short_of.progress.how_to_move), std::string::npos)
+      << progressText(short_of.progress);
   ASSERT_TRUE(short_of.verdict);
   EXPECT_FALSE(short_of.verdict->passed);
   EXPECT_NE(short_of.verdict->text.find("max_std_dev_deg"), std::string::npos);
@@ -181,6 +185,21 @@ TEST(CalibrationSnapshot, ASavedEstimateIsTheBestThatPassedWhileTheTfStays) {
   // And it is the better estimate of the truth here too (within its 3 sigma).
   EXPECT_LT(rad2deg(geodesicDistance(now.result->R_cam_imu, sim::Trajectory(c).R_cam_imu_final())),
             3.0 * now.maxStdDevDeg() * std::sqrt(3.0));
+}
+
+// The rotation to make next, in a driver's words (issue 26: the status tells how to drive): the
+// axis against the vertical in the camera frame, on constructed axes at 0, 45 and 90 deg from it,
+// whichever way the camera looks.
+TEST(CalibrationSnapshot, HowToMoveSaysTurnOrTiltFromTheAxisAndTheVertical) {
+  const Eigen::Vector3d up_cam = Eigen::Vector3d(0.0, -1.0, 0.2).normalized();  // camera level-ish
+  const Eigen::Vector3d horizontal = up_cam.cross(Eigen::Vector3d::UnitZ()).normalized();
+  EXPECT_EQ(howToMove(up_cam, up_cam).rfind("turn in place", 0), 0u) << howToMove(up_cam, up_cam);
+  EXPECT_EQ(howToMove(-up_cam, up_cam).rfind("turn in place", 0), 0u) << "the sign does not matter";
+  EXPECT_EQ(howToMove(horizontal, up_cam).rfind("tilt about a horizontal axis", 0), 0u)
+      << howToMove(horizontal, up_cam);
+  const Eigen::Vector3d between = (up_cam + horizontal).normalized();  // 45 deg
+  EXPECT_EQ(howToMove(between, up_cam).rfind("turn and tilt", 0), 0u) << howToMove(between, up_cam);
+  EXPECT_NE(howToMove(between, up_cam).find("45 deg"), std::string::npos);
 }
 
 }  // namespace

@@ -184,6 +184,7 @@ void AlignmentWrapper::Impl::publishStatus() {
   s.rotate_about_cam.x = axis.x();
   s.rotate_about_cam.y = axis.y();
   s.rotate_about_cam.z = axis.z();
+  s.how_to_move = snap.progress.how_to_move;
   s.imu_guidance = snap.progress.imu_guidance;
   if (!s.imu_guidance.empty()) s.message += "; " + s.imu_guidance;
   if (broadcast) {

@@ -73,6 +73,10 @@ struct CalibrationProgress {
   Eigen::Vector3d rotate_about_cam = Eigen::Vector3d::UnitX();
   /// Which IMU parameters are still held at their priors and how to excite them ("" when none).
   std::string imu_guidance;
+  /// rotate_about_cam in the words of someone moving a rig or driving a robot, from its angle to
+  /// the vertical at the newest rest: "turn in place (about the vertical)", "tilt about a
+  /// horizontal axis (...)" or "turn and tilt"; "" when the vertical is not known.
+  std::string how_to_move;
 };
 
 /// A saved calibration (a result YAML) as a broadcast estimate: its per-axis 1-sigma as a diagonal
@@ -82,9 +86,14 @@ BroadcastEstimate storedBroadcast(const StoredCalibration& stored, const std::st
 /// "IMU parameters held at their priors: ...; to calibrate them, rotate about the camera axis
 /// (x, y, z)" for a joint estimate that holds some ("" otherwise).
 std::string imuGuidanceOf(const EstimateEvent& estimate);
-/// The progress of the latest estimate towards max_std_dev_deg.
-CalibrationProgress progressOf(const std::optional<EstimateEvent>& estimate,
-                               double max_std_dev_deg);
+/// The progress of the latest estimate towards max_std_dev_deg. With `up_cam` (the vertical, up,
+/// in the camera frame at the newest rest; unit), how_to_move says how to rotate next.
+CalibrationProgress progressOf(const std::optional<EstimateEvent>& estimate, double max_std_dev_deg,
+                               const std::optional<Eigen::Vector3d>& up_cam = std::nullopt);
+/// How to rotate about `axis_cam` given the vertical `up_cam` (both unit, camera frame): within 30
+/// deg of the vertical "turn in place", beyond 60 deg "tilt", else "turn and tilt" (see
+/// CalibrationProgress::how_to_move).
+std::string howToMove(const Eigen::Vector3d& axis_cam, const Eigen::Vector3d& up_cam);
 
 /// What OnlineCalibrator::snapshot() copies: the state alone (the status and diagnostics, published
 /// every second and on every change), or also the histories of poses, rests and rejected rests (up
@@ -101,7 +110,7 @@ struct InputCounts {
 };
 /// One line for the logs: "1-sigma 0.120 deg, max_std_dev_deg 0.050 reached" or "1-sigma 0.120
 /// deg > max_std_dev_deg 0.050: about 9 more poses, rotating about the camera axis (0.10, 0.99,
-/// 0.00)".
+/// 0.00)", with how_to_move after it when known ("...: turn in place (about the vertical)").
 std::string progressText(const CalibrationProgress& progress);
 
 struct CalibrationSnapshot {

@@ -90,8 +90,8 @@ JointProblem posesBefore(const JointProblem& problem, int end) {
 /// excess the camera's. Loose: a remount needs only one later test to pass it.
 constexpr double kExcessBeforeLevel = 0.05;
 
-bool cameraExcessBefore(const JointProblem& problem, int split, const Eigen::Matrix3d& start,
-                        JointSettings settings) {
+bool posesBeforeShowExcess(const JointProblem& problem, int split, const Eigen::Matrix3d& start,
+                           JointSettings settings) {
   const JointProblem before = posesBefore(problem, split);
   const JointResult fit = JointEstimator(settings).solve(before, start);
   settings.camera_excess_level = kExcessBeforeLevel;
@@ -172,11 +172,11 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
   }
   std::vector<Eigen::Matrix3d> before, after;
   int best = -1;
-  // The camera's noise as the recording shows it (JointSettings::camera_excess_level), measured
-  // per candidate under the two-mount model; where that adds any, the one-mount fit is redone on
+  // The camera's noise as the recording shows it (JointSettings::camera_excess_level): the
+  // window's measured excess, for a candidate whose poses before it show an excess of their own
+  // (judged with the model of T_g and T_a the one-mount estimate selected: where it held them at
+  // identity, the misfit they would absorb is the camera's); the one-mount fit is then redone on
   // the same noise so that both fits are compared on it.
-  // The excess is measured with the model of T_g and T_a the one-mount estimate selected: where
-  // it held them at identity, the misfit they would absorb is the camera's.
   JointSettings noise_settings = two_mount_settings;
   noise_settings.imu_matrices = one_mount.imu_matrices;
   const JointResult reference_stated = reference;
@@ -184,7 +184,7 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
     JointProblem noisy = measured;
     double excess = 0.0;
     if (one_mount.camera_excess_variance_rad2 > 0.0 &&
-        cameraExcessBefore(measured, s, reference_stated.R_cam_imu, noise_settings)) {
+        posesBeforeShowExcess(measured, s, reference_stated.R_cam_imu, noise_settings)) {
       excess = one_mount.camera_excess_variance_rad2;
     }
     reference = reference_stated;

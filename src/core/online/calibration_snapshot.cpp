@@ -77,8 +77,30 @@ std::string imuGuidanceOf(const EstimateEvent& estimate) {
   return "IMU parameters held at their priors: " + held + text;
 }
 
-CalibrationProgress progressOf(const std::optional<EstimateEvent>& estimate,
-                               double max_std_dev_deg) {
+std::string howToMove(const Eigen::Vector3d& axis_cam, const Eigen::Vector3d& up_cam) {
+  const double cosine = std::abs(axis_cam.normalized().dot(up_cam.normalized()));
+  if (!std::isfinite(cosine)) return "";
+  const double from_vertical_deg = std::acos(std::min(1.0, cosine)) * 180.0 / M_PI;
+  char text[200];
+  if (from_vertical_deg <= 30.0) {
+    std::snprintf(text, sizeof(text),
+                  "turn in place (about the vertical; the axis is %.0f deg from it)",
+                  from_vertical_deg);
+  } else if (from_vertical_deg >= 60.0) {
+    std::snprintf(text, sizeof(text),
+                  "tilt about a horizontal axis (pitch or roll; a robot: a ramp, a kerb or uneven "
+                  "ground; the axis is %.0f deg from the vertical)",
+                  from_vertical_deg);
+  } else {
+    std::snprintf(text, sizeof(text),
+                  "turn and tilt together (the axis is %.0f deg from the vertical)",
+                  from_vertical_deg);
+  }
+  return text;
+}
+
+CalibrationProgress progressOf(const std::optional<EstimateEvent>& estimate, double max_std_dev_deg,
+                               const std::optional<Eigen::Vector3d>& up_cam) {
   CalibrationProgress progress;
   progress.max_std_dev_deg = max_std_dev_deg;
   progress.std_dev_deg = std::numeric_limits<double>::infinity();
@@ -91,6 +113,9 @@ CalibrationProgress progressOf(const std::optional<EstimateEvent>& estimate,
   if (estimate->gate.determined && r.joint && r.joint->ok && !progress.imu_guidance.empty()) {
     progress.rotate_about_cam =
         (r.joint->R_cam_imu * r.joint->suggested_rotation_axis_imu).normalized();
+  }
+  if (up_cam && up_cam->allFinite() && up_cam->norm() > 0.5) {
+    progress.how_to_move = howToMove(progress.rotate_about_cam, *up_cam);
   }
   if (r.status != SolveStatus::kOk || !r.quality.std_dev_deg.allFinite()) return progress;
   progress.std_dev_deg = r.quality.std_dev_deg.maxCoeff();
@@ -119,6 +144,7 @@ std::string progressText(const CalibrationProgress& progress) {
                   "the camera axis (%.2f, %.2f, %.2f)",
                   progress.std_dev_deg, progress.max_std_dev_deg, progress.poses_needed, axis.x(),
                   axis.y(), axis.z());
+    if (!progress.how_to_move.empty()) return text + (": " + progress.how_to_move);
   }
   return text;
 }

@@ -520,7 +520,13 @@ CalibrationSnapshot OnlineCalibrator::snapshot(SnapshotContents contents) const 
     s.check = checkCalibration(c.last_estimate->result, *c.broadcast, c.settings.consistency_level);
   }
   s.remounts = c.remounts;
-  s.progress = progressOf(c.last_estimate, c.settings.max_std_dev_deg);
+  // The vertical at the newest rest in the camera frame: R_world_imu's z is up (gravity).
+  std::optional<Eigen::Vector3d> up_cam;
+  if (c.last_estimate && !s.window.empty()) {
+    up_cam = c.last_estimate->result.R_cam_imu * s.window.back().R_world_imu.transpose() *
+             Eigen::Vector3d::UnitZ();
+  }
+  s.progress = progressOf(c.last_estimate, c.settings.max_std_dev_deg, up_cam);
   return s;
 }
 
