@@ -114,7 +114,8 @@ bool runVisp(VispOutcome* out, double camera_excess_level = JointSettings{}.came
 // board, the arm's kinematics), not of the pixels. Measured now (JointSettings::
 // camera_excess_level: the rests' camera noise as the recording shows it, 0.31 deg per axis
 // added): T_g and T_a held at identity, 0.041 deg from ViSP's eMc with a 1-sigma of [0.13 0.14
-// 0.26] deg, no verdict after any pose (the closest: 7 poses, corrected p 5e-4 at level 1e-4).
+// 0.26] deg, no verdict after any pose (7 poses: suspected, p 6e-5 with one pose after the split,
+// pending; the 8th pose clears it, p 0.048).
 TEST(VispRecording, WithinTwoTenthsOfVispAndNoRemountAtAll) {
   if (!std::ifstream(kDir + "/franka_image-1.png")) GTEST_SKIP() << "no realdata at " << kDir;
   VispOutcome o;

@@ -23,10 +23,11 @@
 //
 // The camera's noise as the recording shows it (JointSettings::camera_excess_level): real PnP's
 // errors beyond its stated covariance on every pose (ViSP's real images: 0.31 deg per axis) would
-// read as a remount of the newest poses. Each candidate measures that excess under its two-mount
-// model (the larger model's residuals, as an F test estimates the error variance: fitted with one
-// mount, a remount's misfit spreads over the whole window and would pass for noise), with the
-// model of T_g and T_a the one-mount estimate selected, and compares both fits with it added.
+// read as a remount of the newest poses. Both fits of a candidate get the excess the one-mount
+// estimate measured on the whole window when the poses before the candidate show an excess of
+// their own (their chi-square test at 0.05, with the model of T_g and T_a the one-mount estimate
+// selected); otherwise they are compared at the stated noise: fitted with one mount, a remount's
+// misfit spreads over the whole window and would pass for noise.
 //
 // Where the change is: the candidate with the largest D that fits every pose is the
 // maximum-likelihood split (first_pose_after). Candidates run up to the newest pose; those with
@@ -76,7 +77,8 @@ struct MountChangeCandidate {
   int dof = 0;               ///< dof_D
   double p_value = 1;        ///< of F, not corrected
   double scale = 1;          ///< max(1, chi2 / dof) of the two-mount fit
-  /// Camera variance added to every rest (rad^2 per axis), measured under the two-mount model.
+  /// Camera variance added to every rest (rad^2 per axis) in both fits: the one-mount estimate's
+  /// camera_excess_variance_rad2 when the poses before the split show an excess, else 0.
   double camera_excess_variance_rad2 = 0;
   /// At least min_poses_after poses after it: can be declared (else it competes for the location).
   bool declarable = false;

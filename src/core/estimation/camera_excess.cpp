@@ -19,7 +19,7 @@ constexpr double kChiSquare3Median = 2.366;
 }  // namespace
 
 double cameraExcessVariance(const JointProblem& problem, const JointResult& result,
-                            const JointSettings& settings, bool tested) {
+                            const JointSettings& settings) {
   std::vector<Eigen::Vector3d> residuals;
   std::vector<Eigen::Matrix3d> covariances;
   const double floor2 = settings.camera_sigma_floor_rad * settings.camera_sigma_floor_rad;
@@ -46,7 +46,7 @@ double cameraExcessVariance(const JointProblem& problem, const JointResult& resu
   double total = 0.0;
   for (double chi2 : at_stated) total += chi2;
   const int dof = 3 * static_cast<int>(residuals.size());
-  if (tested && !(chiSquareUpperTail(total, dof) < settings.camera_excess_level)) return 0.0;
+  if (!(chiSquareUpperTail(total, dof) < settings.camera_excess_level)) return 0.0;
   if (!(median(at_stated) > kChiSquare3Median)) return 0.0;
   // The median chi-square falls as the variance grows: bisection in log(variance), from a
   // nanoradian to a radian.

@@ -12,10 +12,8 @@ namespace joint {
 /// (result.camera_residual_rad, of a solve of `problem`) pass their chi-square test at
 /// settings.camera_excess_level, or when the median rest already fits (the misfit is a few
 /// poses': a remount or a bad pose, which the mount-change test judges).
-/// With `tested` false the chi-square test is skipped (the median criterion alone): for a caller
-/// that already knows the window as a whole shows an excess and measures it on part of it.
 double cameraExcessVariance(const JointProblem& problem, const JointResult& result,
-                            const JointSettings& settings, bool tested = true);
+                            const JointSettings& settings);
 
 }  // namespace joint
 }  // namespace camera_imu_alignment

@@ -5,6 +5,7 @@
 #include <boost/math/distributions/fisher_f.hpp>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 
 #include "camera_excess.h"
@@ -180,21 +181,25 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
   JointSettings noise_settings = two_mount_settings;
   noise_settings.imu_matrices = one_mount.imu_matrices;
   const JointResult reference_stated = reference;
+  // The one-mount fit at the window's excess, the same for every candidate that uses it (solved
+  // once, when the first does; not ok: those candidates are compared at the stated noise).
+  JointProblem measured_noisy = measured;
+  addCameraExcessVariance(one_mount.camera_excess_variance_rad2, &measured_noisy);
+  std::optional<JointResult> reference_noisy;
   for (int s = first; s < n; ++s) {
     JointProblem noisy = measured;
     double excess = 0.0;
+    reference = reference_stated;
     if (one_mount.camera_excess_variance_rad2 > 0.0 &&
         posesBeforeShowExcess(measured, s, reference_stated.R_cam_imu, noise_settings)) {
-      excess = one_mount.camera_excess_variance_rad2;
-    }
-    reference = reference_stated;
-    if (excess > 0.0) {
-      addCameraExcessVariance(excess, &noisy);
-      reference = solveScreeningCameraLinks(estimator, noisy, reference_stated.R_cam_imu);
-      if (!reference.ok || reference.dof <= 0) {  // compared at the stated noise instead
-        reference = reference_stated;
-        noisy = measured;
-        excess = 0.0;
+      if (!reference_noisy) {
+        reference_noisy =
+            solveScreeningCameraLinks(estimator, measured_noisy, reference_stated.R_cam_imu);
+      }
+      if (reference_noisy->ok && reference_noisy->dof > 0) {
+        excess = one_mount.camera_excess_variance_rad2;
+        noisy = measured_noisy;
+        reference = *reference_noisy;
       }
     }
     // Natural-scene rotations screened in each model on its own, those left out counted at the
