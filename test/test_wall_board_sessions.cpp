@@ -4,7 +4,8 @@
 // with the default settings (a consumer unit's priors), camera orientations given (the truth with
 // 0.03 deg of noise per frame at 15 Hz, as test_joint_pipeline). Errors against the simulated
 // truth in the package's IMU frame (the accelerometer's axes), per-axis against the reported
-// 1-sigma. Set CIA_WALL_BOARD_SEEDS to run more seeds than the tests' 20.
+// 1-sigma. Set CIA_WALL_BOARD_SEEDS to run more seeds than the tests' 20, and
+// CIA_WALL_BOARD_EXACT_NOISE=1 to tell the estimator the simulator's own spread of every error.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -98,7 +99,13 @@ WallBoardOutcome runWallBoard(sim::ImuGrade grade, bool systematic, int count,
     const sim::SimulationRun run(c);
     PipelineSettings settings;
     if (solve.unit_priors) settings.joint = test::jointSettingsFor(c);
-    if (!solve.motion) settings.motion_window_s = 0.0;
+    if (std::getenv("CIA_WALL_BOARD_EXACT_NOISE") != nullptr) {
+      // The estimator told the simulator's own spread of every error (an information bound):
+      // the unit's priors, the accelerometer's initial bias at its sigma (not 2x), both walks.
+      settings.joint = test::jointSettingsFor(c);
+      settings.joint.priors.accel_bias_m_s2 = c.imu_noise.accelerometer_initial_bias_sigma;
+      settings.joint.priors.gyro_bias_walk_rad_s_sqrt_s = c.imu_noise.gyroscope_random_walk;
+    }
     const bool rendered = std::getenv("CIA_WALL_BOARD_RENDERED") != nullptr;
     test::PipelineRun rendered_run;
     std::unique_ptr<CalibrationPipeline> fed;
@@ -179,7 +186,10 @@ void expectHonest(const WallBoardOutcome& o) {
 // (before: "held at its prior: gravity direction spread 0.050-0.123 < 0.100" in most). The issue's
 // target of 0.06 deg RMS is not met: the error is the information the session carries (with T_g
 // known exactly 0.020, with T_a known 0.028, with the soft iron known 0.045), and the reported
-// 1-sigma says so. Asserted: the max target (0.15) and 3 sigma, RMS within 0.10.
+// 1-sigma says so. Told the simulator's exact spread of every error (CIA_WALL_BOARD_EXACT_NOISE=1,
+// 2026-11-27) the estimator's posterior 1-sigma is 0.0925 deg RMS and its error 0.0803 (max 0.166):
+// the Bayesian bound on these sessions is above 0.06. Asserted: the max target (0.15) and 3 sigma,
+// RMS within 0.10.
 TEST(WallBoardSessions, ConsumerGradeWithSystematicErrors) {
   const WallBoardOutcome o = runWallBoard(sim::ImuGrade::kConsumer, true, seedCount());
   expectHonest(o);
