@@ -62,7 +62,7 @@ struct MotionFrame {
   Eigen::Matrix3d R_target_cam = Eigen::Matrix3d::Identity();
   /// Covariance of R_target_cam (rad^2, camera axes, right perturbation), e.g. PnP's.
   Eigen::Matrix3d cov_cam_rad2 = Eigen::Matrix3d::Zero();
-  /// The camera's centre in the target frame (m), when known (PnP, camera_pose): the positions
+  /// The camera's centre in the target frame (m), when known (PnP, camera_pose): the velocities
   /// the acceleration model needs (JointSettings::motion_accel_link_s).
   std::optional<Eigen::Vector3d> p_target_cam_m;
   /// The PnP fit it came from: RMS reprojection error (px) over reprojection_dof = 2 N - 6
@@ -83,20 +83,16 @@ struct GyroStream {
   double accel_noise_density_m_s2_sqrt_hz = 0;  ///< measured white noise (m/s^2/sqrt(Hz))
 };
 
-/// The accelerometer during motion over three motion nodes (set by the estimator): gravity plus the
-/// rig's acceleration, integrated with a triangular weight (0 at `from` and `to`, 1 at `mid`),
-/// against the change between the camera centre's mean velocities over [from, mid] and [mid, to],
-/// which the camera's positions at the three nodes give: (p_to - p_mid) / T2 - (p_mid - p_from) /
-/// T1 = integral of w(t) a_world(t) dt. Positions, not velocities differenced over one frame: the
-/// same position noise gives a sigma about 8x smaller over 1 s intervals.
+/// The accelerometer during motion between two motion nodes (set by the estimator): gravity plus
+/// the rig's acceleration, against the change of the IMU's velocity the camera's positions give.
 struct AccelLink {
-  int from_pose = 0, mid_pose = 0, to_pose = 0;  ///< motion nodes (JointProblem::poses), in order
-  GyroStream samples;  ///< gyro and accelerometer over [from, to] and a margin
-  /// The camera centre's mean velocities over [from, mid] and [mid, to] (target frame, m/s).
+  int from_pose = 0, to_pose = 0;  ///< motion nodes (JointProblem::poses), from < to
+  GyroStream samples;              ///< gyro and accelerometer over the interval and a margin
+  /// The velocities of the camera centre at the two nodes (target frame, m/s), from
+  /// the camera positions around them, and their 1-sigma per axis.
   Eigen::Vector3d v_from_target_m_s = Eigen::Vector3d::Zero(),
                   v_to_target_m_s = Eigen::Vector3d::Zero();
-  /// 1-sigma per axis of v_to - v_from (m/s), from the positions' noise.
-  double velocity_difference_sigma_m_s = 0;
+  double velocity_sigma_m_s = 0;
 };
 
 /// The camera's rotation between two poses measured without a target (vision/scene_rotation.h):
@@ -265,11 +261,11 @@ struct JointSettings {
   /// Motion nodes further than this (s) from the next node or rest are linked to it only when
   /// the gyro covers the gap: beyond it the chain breaks (the target was out of view).
   double motion_max_link_s = 2.0;
-  /// The acceleration model (AccelLink): three motion nodes about this far apart (s), the
-  /// accelerometer against the camera's positions; 0: the accelerometer is used at rests only.
-  /// Longer intervals: the positions' noise weighs less against gravity x duration.
+  /// The acceleration model: the accelerometer between motion nodes about this far apart (s)
+  /// against the change of velocity from the camera's positions; 0: the accelerometer is used at
+  /// rests only. Longer links: the velocities' noise weighs less against gravity x duration.
   double motion_accel_link_s = 1.0;
-  /// 1-sigma (m) of each axis of a camera position (PnP, camera_pose) in the acceleration model.
+  /// 1-sigma (m) of a camera position (PnP, camera_pose) for the velocities by central difference.
   double camera_position_sigma_m = 1e-3;
   /// 1-sigma (m) of the prior on each axis of the IMU's position in the camera frame (the lever
   /// arm the acceleration model needs; estimated with it).

@@ -86,20 +86,18 @@ State initialState(const JointProblem& problem, const Eigen::Matrix3d& R_cam_imu
       if (problem.poses[k].at_rest) up_target = R_target_imu[k] * problem.poses[k].accel_mean_m_s2;
     }
   }
-  // Without rests, up from the accelerometer links: R_target_imu_mid int w f dt = dv_target +
-  // up g int w dt.
+  // Without rests, up from the accelerometer links: R_target_imu int f dt = dv_target + up g T.
   if (!(up_target.norm() > 1e-6)) {
     for (const AccelLink& link : problem.accel_links) {
       const JointPose& from = problem.poses[link.from_pose];
       const Eigen::Vector3d b(state.gyro_bias[link.from_pose][0],
                               state.gyro_bias[link.from_pose][1],
                               state.gyro_bias[link.from_pose][2]);
-      const AccelLinkIntegral in = integrateAccelLink(
-          link.samples, from.start_s, problem.poses[link.mid_pose].start_s,
-          problem.poses[link.to_pose].start_s, Eigen::Matrix3d::Identity(), b, b);
-      up_target +=
-          projectToSO3(problem.poses[link.mid_pose].R_target_cam) * state.R_cam_imu_0 * in.dv0 -
-          (link.v_to_target_m_s - link.v_from_target_m_s);
+      const AccelLinkIntegral in =
+          integrateAccelLink(link.samples, from.start_s, problem.poses[link.to_pose].start_s,
+                             Eigen::Matrix3d::Identity(), b, b);
+      up_target += projectToSO3(from.R_target_cam) * state.R_cam_imu_0 * in.dv0 -
+                   (link.v_to_target_m_s - link.v_from_target_m_s);
     }
   }
   // Without rests or links W is a gauge: any axis.

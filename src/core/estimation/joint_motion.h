@@ -29,22 +29,16 @@ std::string validateMotion(const JointProblem& problem);
 ExpandedProblem expandMotion(const JointProblem& problem, const JointSettings& settings);
 
 /// An accelerometer link preintegrated at the gyro model and time offset of a pass, in the IMU
-/// frame at its middle node (the weight's peak), with the link's triangular weight w(t)
-/// (AccelLink): dv0 = int w DeltaR(t) a(t) dt (raw accelerometer), bias_jacobian = int w DeltaR dt,
-/// and per_entry(r, 3 s + u) = int w DeltaR(t)(r, s) a_u(t) dt, so that the integral of w DeltaR
-/// (T_a^-1 (a - b)) ~ dv0 - bias_jacobian b - sum_su P_su per_entry(:, 3 s + u) with P = T_a - I
-/// (first order).
+/// frame at the link's start: dv0 = int DeltaR(t) a(t) dt (raw accelerometer), bias_jacobian = int
+/// DeltaR dt, and per_entry(r, 3 s + u) = int DeltaR(t)(r, s) a_u(t) dt, so that the integral of
+/// DeltaR (T_a^-1 (a - b)) ~ dv0 - bias_jacobian b - sum_su P_su per_entry(:, 3 s + u) with
+/// P = T_a - I (first order). rate_from/rate_to: the calibrated body rates at the ends (rad/s).
 struct AccelLinkIntegral {
   Eigen::Vector3d dv0 = Eigen::Vector3d::Zero();
   Eigen::Matrix3d bias_jacobian = Eigen::Matrix3d::Zero();
   Eigen::Matrix<double, 3, 9> per_entry = Eigen::Matrix<double, 3, 9>::Zero();
-  double duration_s = 0;       ///< to - from
-  double weight_s = 0;         ///< int w dt: gravity's share, g_world weight_s
-  double weight_square_s = 0;  ///< int w^2 dt: the accelerometer's white noise, density^2 x this
-  /// The integral over u of (int w dt from the middle node's far side to u)^2, (T1^3 + T2^3) / 20
-  /// (s^3): the gyro's white noise turning the integrated specific force from the middle node
-  /// outwards, density^2 g^2 x this per axis across it.
-  double rotation_noise_s3 = 0;
+  Eigen::Vector3d rate_from = Eigen::Vector3d::Zero(), rate_to = Eigen::Vector3d::Zero();
+  double duration_s = 0;
   /// d dv0 / d theta, theta = [T_g row-major (9), gyro bias at the start (3), at the end (3)]
   /// (numerical), and theta at which it was taken (T_g entries with I subtracted): the
   /// accelerometer's integral follows the gyro model within a pass.
@@ -52,11 +46,10 @@ struct AccelLinkIntegral {
   Eigen::Matrix<double, 15, 1> theta0_minus_identity = Eigen::Matrix<double, 15, 1>::Zero();
 };
 
-/// The link over [t_from_s, t_to_s] (IMU clock) with its weight's peak at t_mid_s, under T_g and
-/// the gyro biases at its ends.
-AccelLinkIntegral integrateAccelLink(const GyroStream& samples, double t_from_s, double t_mid_s,
-                                     double t_to_s, const Eigen::Matrix3d& T_g,
-                                     const Eigen::Vector3d& b_from, const Eigen::Vector3d& b_to);
+/// The link between t_from_s and t_to_s (IMU clock) under T_g and the gyro biases at its ends.
+AccelLinkIntegral integrateAccelLink(const GyroStream& samples, double t_from_s, double t_to_s,
+                                     const Eigen::Matrix3d& T_g, const Eigen::Vector3d& b_from,
+                                     const Eigen::Vector3d& b_to);
 
 /// Maps a result of the expanded problem back to the caller's rests (per-pose vectors, the poses
 /// left out, the mount change); motion nodes are counted in motion_nodes.

@@ -382,30 +382,11 @@ class Builder {
   /// The accelerometer between motion nodes, with its bias during motion and the lever arm.
   void addAccelLinks(const std::vector<AccelLinkIntegral>& integrals) {
     const ImuModelPriors& p = settings_.priors;
-    // The bias during the links: the first with the bias prior, each next one a random walk from
-    // the one before (link centres dt apart), as the rests' biases.
-    const size_t links = problem_.accel_links.size();
-    if (state_.link_accel_bias.size() != links) state_.link_accel_bias.assign(links, {0, 0, 0});
-    const auto centre = [&](const AccelLink& link) {
-      return problem_.poses[static_cast<size_t>(link.mid_pose)].start_s;
-    };
-    for (size_t j = 0; j < links; ++j) {
-      addBlock(state_.link_accel_bias[j].data(), 3);
-      if (j == 0) {
-        record(ceres_.AddResidualBlock(
-                   maskedPrior(3, {0, 1, 2}, std::vector<double>(3, p.accel_bias_m_s2)), nullptr,
-                   state_.link_accel_bias[j].data()),
-               -1, -1, 3);
-        continue;
-      }
-      const double dt = std::max(
-          centre(problem_.accel_links[j]) - centre(problem_.accel_links[j - 1]), kMinWalkDt);
-      auto* walk = new ceres::AutoDiffCostFunction<BiasWalkResidual, 3, 3, 3>(
-          new BiasWalkResidual{1.0 / (p.accel_bias_walk_m_s2_sqrt_s * std::sqrt(dt))});
-      record(ceres_.AddResidualBlock(walk, nullptr, state_.link_accel_bias[j - 1].data(),
-                                     state_.link_accel_bias[j].data()),
-             -1, -1, 3);
-    }
+    addBlock(state_.motion_accel_bias.data(), 3);
+    record(ceres_.AddResidualBlock(
+               maskedPrior(3, {0, 1, 2}, std::vector<double>(3, p.accel_bias_m_s2)), nullptr,
+               state_.motion_accel_bias.data()),
+           -1, -1, 3);
     addBlock(state_.lever_arm_m.data(), 3);
     record(ceres_.AddResidualBlock(
                maskedPrior(3, {0, 1, 2}, std::vector<double>(3, settings_.lever_arm_prior_m)),
@@ -417,38 +398,22 @@ class Builder {
       const size_t from = static_cast<size_t>(link.from_pose),
                    to = static_cast<size_t>(link.to_pose);
       const Eigen::Matrix3d R_tc_from = projectToSO3(problem_.poses[from].R_target_cam);
-      const size_t mid = static_cast<size_t>(link.mid_pose);
-      const Eigen::Matrix3d R_tc_mid = projectToSO3(problem_.poses[mid].R_target_cam);
       const Eigen::Matrix3d R_tc_to = projectToSO3(problem_.poses[to].R_target_cam);
-      const double t1 =
-          problem_.poses[static_cast<size_t>(link.mid_pose)].start_s - problem_.poses[from].start_s;
-      const double t2 = in.duration_s - t1;
-      const Eigen::Matrix3d& X0 = cameraImu0(mid);
-      // The accelerometer's white noise, the gyro's turning the integrated specific force (about
-      // g x weight_s; across it, counted on every axis), and the positions'.
+      const Eigen::Matrix3d& X0 = cameraImu0(from);
       const double density = link.samples.accel_noise_density_m_s2_sqrt_hz;
-      const double gyro_density = link.samples.noise_density_rad_s_sqrt_hz;
-      const double g = settings_.gravity_m_s2;
-      const double variance =
-          density * density * in.weight_square_s +
-          gyro_density * gyro_density * g * g * in.rotation_noise_s3 +
-          link.velocity_difference_sigma_m_s * link.velocity_difference_sigma_m_s;
+      const double variance = density * density * in.duration_s +
+                              2.0 * link.velocity_sigma_m_s * link.velocity_sigma_m_s;
       auto* cost = new ceres::AutoDiffCostFunction<AccelLinkResidual, 3, 3, 3, 3, 6, 3, 3, 9, 3, 3>(
-          new AccelLinkResidual{targetCam(mid), X0, state_.R_world_target_0, in.dv0,
-                                in.bias_jacobian, in.per_entry,
-                                link.v_to_target_m_s - link.v_from_target_m_s,
-                                (R_tc_to - R_tc_mid) / t2 - (R_tc_mid - R_tc_from) / t1, g,
-                                in.weight_s, 1.0 / std::sqrt(variance), settings_.accel_matrix_form,
-                                in.gyro_jacobian, in.theta0_minus_identity});
-      const std::vector<double*> blocks = {state_.e_T.data(),
-                                           cameraImuIncrement(mid),
-                                           state_.delta[mid].data(),
-                                           state_.accel_matrix.data(),
-                                           state_.link_accel_bias[j].data(),
-                                           state_.lever_arm_m.data(),
-                                           state_.gyro_matrix.data(),
-                                           state_.gyro_bias[from].data(),
-                                           state_.gyro_bias[to].data()};
+          new AccelLinkResidual{
+              targetCam(from), X0, state_.R_world_target_0, in.dv0, in.bias_jacobian, in.per_entry,
+              link.v_to_target_m_s - link.v_from_target_m_s, R_tc_from * skew(X0 * in.rate_from),
+              R_tc_to * skew(X0 * in.rate_to), settings_.gravity_m_s2, in.duration_s,
+              1.0 / std::sqrt(variance), settings_.accel_matrix_form, in.gyro_jacobian,
+              in.theta0_minus_identity});
+      const std::vector<double*> blocks = {
+          state_.e_T.data(),          cameraImuIncrement(from),        state_.delta[from].data(),
+          state_.accel_matrix.data(), state_.motion_accel_bias.data(), state_.lever_arm_m.data(),
+          state_.gyro_matrix.data(),  state_.gyro_bias[from].data(),   state_.gyro_bias[to].data()};
       record(ceres_.AddResidualBlock(cost, loss_, blocks), static_cast<int>(from),
              static_cast<int>(to), 3);
     }

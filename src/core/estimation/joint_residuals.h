@@ -278,26 +278,25 @@ Vector3<T> worldFromImu(const Eigen::Matrix3d& T0_target_cam, const Eigen::Matri
   return a;
 }
 
-/// The accelerometer over three motion nodes (AccelLink): the change of the IMU's mean velocity in
-/// W from the accelerometer, R_world_imu_mid int w DeltaR T_a^-1 (a - b) dt + g_world int w dt,
-/// against the one the camera's positions give, R_world_target (v_to - v_from + lever l) with
-/// lever = (R_tc_to - R_tc_mid) / T2 - (R_tc_mid - R_tc_from) / T1 (the IMU's position is p_cam +
-/// R_target_cam l, l the IMU's position in the camera frame, m).
+/// The accelerometer between two motion nodes (AccelLink, joint_motion.h): the IMU's change of
+/// velocity in W from the accelerometer, R_world_imu_from int DeltaR T_a^-1 (a - b) dt + g_world T,
+/// against the one the camera's positions give, R_world_target (v_imu_to - v_imu_from) with
+/// v_imu = v_cam + R_target_cam (w_cam x l), l the IMU's position in the camera frame (m).
 struct AccelLinkResidual {
-  Eigen::Matrix3d T0_target_cam_mid, X0, T0;  // T0 R_target_cam_mid, X0, T0 = R_world_target_0
+  Eigen::Matrix3d T0_target_cam_from, X0, T0;  // T0 R_target_cam_from, X0, T0 = R_world_target_0
   Eigen::Vector3d dv0;
   Eigen::Matrix3d bias_jacobian;
   Eigen::Matrix<double, 3, 9> per_entry;
-  Eigen::Vector3d v_cam_difference_target;       // v_cam_to - v_cam_from (target frame, m/s)
-  Eigen::Matrix3d lever;                         // the IMU's velocity difference is lever l
-  double gravity_m_s2, weight_s, inverse_sigma;  // weight_s = int w dt (s)
+  Eigen::Vector3d v_cam_difference_target;  // v_cam_to - v_cam_from (target frame, m/s)
+  Eigen::Matrix3d lever_from, lever_to;     // R_target_cam_k [w_cam_k]x: velocity = lever_k l
+  double gravity_m_s2, duration_s, inverse_sigma;
   AccelMatrixForm form;
   Eigen::Matrix<double, 3, 15> gyro_jacobian;  // d dv0 / d theta (T_g, bias from, bias to)
   Eigen::Matrix<double, 15, 1> theta0_minus_identity;
 
   template <typename T>
   bool operator()(const T* e_T, const T* e_X, const T* delta, const T* accel_matrix,
-                  const T* accel_bias, const T* lever_arm, const T* gyro_matrix, const T* gyro_from,
+                  const T* accel_bias, const T* lever, const T* gyro_matrix, const T* gyro_from,
                   const T* gyro_to, T* residual) const {
     const Matrix3<T> P = accelMatrix(accel_matrix, form) - Matrix3<T>::Identity();
     const Eigen::Map<const Vector3<T>> b(accel_bias);
@@ -311,10 +310,11 @@ struct AccelLinkResidual {
     for (int s = 0; s < 3; ++s) {
       for (int u = 0; u < 3; ++u) f -= P(s, u) * per_entry.col(3 * s + u).cast<T>();
     }
-    Vector3<T> predicted = worldFromImu(T0_target_cam_mid, X0, e_T, delta, e_X, f);
-    predicted(2) -= T(gravity_m_s2 * weight_s);
-    const Eigen::Map<const Vector3<T>> l(lever_arm);
-    const Vector3<T> v_target = v_cam_difference_target.cast<T>() + lever.cast<T>() * l;
+    Vector3<T> predicted = worldFromImu(T0_target_cam_from, X0, e_T, delta, e_X, f);
+    predicted(2) -= T(gravity_m_s2 * duration_s);
+    const Eigen::Map<const Vector3<T>> l(lever);
+    const Vector3<T> v_target =
+        v_cam_difference_target.cast<T>() + lever_to.cast<T>() * l - lever_from.cast<T>() * l;
     const Vector3<T> v_rotated = T0.cast<T>() * v_target;
     Vector3<T> measured;
     ceres::AngleAxisRotatePoint(e_T, v_rotated.data(), measured.data());

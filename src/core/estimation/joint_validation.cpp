@@ -322,11 +322,10 @@ std::vector<AccelLinkIntegral> integrateAccelLinks(const JointProblem& problem,
   constexpr double kStep = 1e-6;  // T_g entries and rad/s: far inside the linear range
   for (const AccelLink& link : problem.accel_links) {
     const double from = problem.poses[link.from_pose].start_s + shift;
-    const double mid = problem.poses[link.mid_pose].start_s + shift;
     const double to = problem.poses[link.to_pose].start_s + shift;
     const Eigen::Vector3d& b_from = biases[link.from_pose];
     const Eigen::Vector3d& b_to = biases[link.to_pose];
-    AccelLinkIntegral base = integrateAccelLink(link.samples, from, mid, to, T_g, b_from, b_to);
+    AccelLinkIntegral base = integrateAccelLink(link.samples, from, to, T_g, b_from, b_to);
     for (int i = 0; i < 15; ++i) {
       Eigen::Matrix3d T = T_g;
       Eigen::Vector3d bf = b_from, bt = b_to;
@@ -338,7 +337,7 @@ std::vector<AccelLinkIntegral> integrateAccelLinks(const JointProblem& problem,
         bt(i - 12) += kStep;
       }
       base.gyro_jacobian.col(i) =
-          (integrateAccelLink(link.samples, from, mid, to, T, bf, bt).dv0 - base.dv0) / kStep;
+          (integrateAccelLink(link.samples, from, to, T, bf, bt).dv0 - base.dv0) / kStep;
     }
     for (int i = 0; i < 9; ++i) base.theta0_minus_identity(i) = T_g(i / 3, i % 3) - (i % 4 == 0);
     base.theta0_minus_identity.segment<3>(9) = b_from;
