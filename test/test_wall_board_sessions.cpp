@@ -106,6 +106,7 @@ WallBoardOutcome runWallBoard(sim::ImuGrade grade, bool systematic, int count,
       settings.joint.priors.accel_bias_m_s2 = c.imu_noise.accelerometer_initial_bias_sigma;
       settings.joint.priors.gyro_bias_walk_rad_s_sqrt_s = c.imu_noise.gyroscope_random_walk;
     }
+    if (!solve.motion) settings.motion_window_s = 0.0;
     const bool rendered = std::getenv("CIA_WALL_BOARD_RENDERED") != nullptr;
     test::PipelineRun rendered_run;
     std::unique_ptr<CalibrationPipeline> fed;
