@@ -181,10 +181,10 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
   JointSettings noise_settings = two_mount_settings;
   noise_settings.imu_matrices = one_mount.imu_matrices;
   const JointResult reference_stated = reference;
-  // The one-mount fit at the window's excess, the same for every candidate that uses it (solved
-  // once, when the first does; not ok: those candidates are compared at the stated noise).
-  JointProblem measured_noisy = measured;
-  addCameraExcessVariance(one_mount.camera_excess_variance_rad2, &measured_noisy);
+  // The window at its excess and the one-mount fit there, the same for every candidate that uses
+  // them (made once, when the first does; the fit not ok: those candidates are compared at the
+  // stated noise).
+  JointProblem measured_noisy;
   std::optional<JointResult> reference_noisy;
   for (int s = first; s < n; ++s) {
     JointProblem noisy = measured;
@@ -193,6 +193,8 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
     if (one_mount.camera_excess_variance_rad2 > 0.0 &&
         posesBeforeShowExcess(measured, s, reference_stated.R_cam_imu, noise_settings)) {
       if (!reference_noisy) {
+        measured_noisy = measured;
+        addCameraExcessVariance(one_mount.camera_excess_variance_rad2, &measured_noisy);
         reference_noisy =
             solveScreeningCameraLinks(estimator, measured_noisy, reference_stated.R_cam_imu);
       }

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "camera_imu_alignment/pipeline/stationary_window.h"
+#include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {
 
@@ -80,7 +81,7 @@ std::string imuGuidanceOf(const EstimateEvent& estimate) {
 std::string howToMove(const Eigen::Vector3d& axis_cam, const Eigen::Vector3d& up_cam) {
   const double cosine = std::abs(axis_cam.normalized().dot(up_cam.normalized()));
   if (!std::isfinite(cosine)) return "";
-  const double from_vertical_deg = std::acos(std::min(1.0, cosine)) * 180.0 / M_PI;
+  const double from_vertical_deg = rad2deg(std::acos(std::min(1.0, cosine)));
   char text[200];
   if (from_vertical_deg <= 30.0) {
     std::snprintf(text, sizeof(text),
