@@ -13,6 +13,7 @@
 #include "camera_imu_alignment/simulation/trajectory.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "pipeline_simulation.h"
+#include "solve_worker.h"
 #include "test_helpers.h"
 
 namespace camera_imu_alignment {
@@ -382,6 +383,40 @@ TEST(OnlineCalibrator, ManualCaptureWantsFramesOnlyWhileArmed) {
   EXPECT_FALSE(c.wantsFrames());
   c.armCapture();
   EXPECT_TRUE(c.wantsFrames());
+}
+
+TEST(OnlineCalibrator, AChangeInWindowsTheBusyWorkerSkippedIsStillTested) {
+  // The worker solves only the newest window; while it is busy (the nodelet's rostest replaying a
+  // consumer unit's remount at 3x: 10-12 s per solve of a mixed window) several poses arrive
+  // unsolved. A split among them must still be a candidate, although it lies beyond the newest
+  // remount_max_poses_after poses: here 5 poses of the new mount (the 8th to 12th) arrive at once.
+  const sim::SimulationConfig c = remountedConfig(sim::ImuGrade::kConsumer, 62, 3.0, 12);
+  const sim::SimulationRun run(c);
+  PipelineSettings settings;
+  settings.imu_orientation = ImuOrientationSource::kJoint;
+  settings.joint = test::jointSettingsFor(c);
+  settings.motion_window_s = 0.0;  // the rests alone: a mixed window's motion costs seconds
+  const auto pipeline = test::feedWithoutImages(run, settings, 0.03, false, 112);
+  SolveJob job;
+  job.window = pipeline->snapshot();
+  job.test_mount_change = true;
+  ASSERT_EQ(job.window.pose_indices.size(), 12u);
+  OnlineSettings online;
+  ASSERT_EQ(online.remount.max_poses_after, 4);
+  // Every window up to the 7th pose was tested: the change before the 8th is out of reach.
+  job.poses_not_yet_tested = 5;
+  const SolveOutput reached = runSolveJob(job, settings, online);
+  ASSERT_TRUE(reached.mount_test.has_value());
+  EXPECT_TRUE(reached.mount_test->detected) << reached.mount_test->message;
+  EXPECT_EQ(reached.mount_test->first_pose_after, 7) << reached.mount_test->message;
+  EXPECT_NEAR(reached.mount_test->change_deg, 3.0, 0.3);
+  // The same window as if its predecessors had all been tested: the split before the 8th pose is
+  // no candidate (only the newest 4 are), so the change cannot be placed there.
+  job.poses_not_yet_tested = 1;
+  const SolveOutput newest_only = runSolveJob(job, settings, online);
+  ASSERT_TRUE(newest_only.mount_test.has_value());
+  EXPECT_FALSE(newest_only.mount_test->detected && newest_only.mount_test->first_pose_after == 7)
+      << newest_only.mount_test->message;
 }
 
 TEST(OnlineCalibrator, TheWorkerThreadGivesTheSameFinalEstimate) {

@@ -79,6 +79,9 @@ struct OnlineCalibrator::Impl {
   /// Continuous motion: a solve after kMotionFramesPerSolve motion frames without one.
   void onMotionFrames();
   std::uint64_t motion_frames_solved = 0;  ///< pipeline->motionFrames() at the last such solve
+  /// StationaryPose::index of the newest pose a change-point test had in its window (-1: none
+  /// since the poses were last cleared).
+  int newest_pose_change_tested = -1;
   void poll();
   void apply(SolveOutput output);
   void applyRemount(const SolveOutput& output);
@@ -114,6 +117,7 @@ void OnlineCalibrator::Impl::checkClock(double stamp_s, InputStream stream) {
   if (jump_s <= 0.0) return;
   pipeline->reset();
   motion_frames_solved = 0;
+  newest_pose_change_tested = -1;
   ++generation;
   inconsistent_poses = 0;
   last_pose.reset();
@@ -186,6 +190,9 @@ void OnlineCalibrator::Impl::requestSolve() {
   job.generation = generation;
   job.window = pipeline->snapshot();
   job.test_mount_change = joint();
+  job.poses_not_yet_tested = static_cast<int>(
+      std::count_if(job.window.pose_indices.begin(), job.window.pose_indices.end(),
+                    [this](int index) { return index > newest_pose_change_tested; }));
   if (worker) {
     worker->submit(std::move(job));
   } else {
@@ -208,6 +215,10 @@ void OnlineCalibrator::Impl::poll() {
 void OnlineCalibrator::Impl::apply(SolveOutput output) {
   if (output.generation != generation) return;  // the window lost poses since: stale
   if (output.result.status == SolveStatus::kBadInput) return;
+  if (output.mount_test && output.mount_test->tested && !output.window.pose_indices.empty()) {
+    newest_pose_change_tested =
+        std::max(newest_pose_change_tested, output.window.pose_indices.back());
+  }
   // A camera model that does not fit the images biases the poses as a remount would: no remount
   // is declared then (the estimate is refused, naming camera_info).
   if (output.mount_test && output.mount_test->detected && !pipeline->cameraModelCheck().wrong) {
@@ -432,6 +443,7 @@ void OnlineCalibrator::reset() {
   impl_->poll();
   impl_->pipeline->reset();
   impl_->motion_frames_solved = 0;
+  impl_->newest_pose_change_tested = -1;
   ++impl_->generation;
   impl_->last_estimate.reset();
   impl_->last_pose.reset();

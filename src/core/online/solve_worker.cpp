@@ -1,6 +1,7 @@
 // SolveWorker and runSolveJob (solve_worker.h).
 #include "solve_worker.h"
 
+#include <algorithm>
 #include <utility>
 
 namespace camera_imu_alignment {
@@ -11,8 +12,14 @@ SolveOutput runSolveJob(SolveJob job, const PipelineSettings& pipeline,
   out.generation = job.generation;
   out.result = solveWindow(job.window, pipeline);
   if (job.test_mount_change && out.result.joint && out.result.joint->ok) {
-    out.mount_test = testMountChange(job.window.joint, *out.result.joint, jointSettingsOf(pipeline),
-                                     online.remount);
+    // A split whose first pose was never a candidate of a test (its windows were skipped) is
+    // one: the splits with fewer than min_poses_after poses after them in the last tested window
+    // were only pending, so the reach is the untested poses plus min_poses_after - 1.
+    MountChangeSettings remount = online.remount;
+    remount.max_poses_after = std::max(remount.max_poses_after,
+                                       job.poses_not_yet_tested + remount.min_poses_after - 1);
+    out.mount_test =
+        testMountChange(job.window.joint, *out.result.joint, jointSettingsOf(pipeline), remount);
   }
   out.window = std::move(job.window);
   return out;

@@ -19,6 +19,10 @@ struct SolveJob {
   std::uint64_t generation = 0;  ///< the window's generation when taken (reset, remount, jump)
   WindowSnapshot window;
   bool test_mount_change = false;
+  /// The window's newest poses that no earlier change-point test had among its poses (the
+  /// worker skipped their windows while it was busy): the test's candidate splits reach back
+  /// to them as well as to the newest remount_max_poses_after.
+  int poses_not_yet_tested = 0;
 };
 
 struct SolveOutput {
