@@ -137,6 +137,9 @@ std::string validateConfig(const SimulationConfig& c) {
     e << "motion time range must satisfy 0.2 <= move_min_s <= move_max_s <= 600; ";
   if (!inRange(c.waving_duration_s, 1, 3600)) e << "waving_duration_s must be in [1, 3600]; ";
   if (!inRange(c.camera_pose_noise_deg, 0, 10)) e << "camera_pose_noise_deg must be in [0, 10]; ";
+  if (!inRange(c.camera_pose_position_noise_m, 0, 0.1)) {
+    e << "camera_pose_position_noise_m must be in [0, 0.1]; ";
+  }
   if (!inRange(c.max_tilt_deg, 0, 60)) e << "max_tilt_deg must be in [0, 60]; ";
   if (!inRange(c.max_roll_deg, 0, 180)) e << "max_roll_deg must be in [0, 180]; ";
   if (!inRange(c.min_distance_m, 0.1, 10) || !inRange(c.max_distance_m, c.min_distance_m, 10))

@@ -129,6 +129,8 @@ std::vector<CameraOrientation> simulateCameraOrientations(const SimulationConfig
   std::mt19937_64 rng(streamSeed(config.seed, 7));
   std::normal_distribution<double> unit(0.0, 1.0);
   const double sigma = deg2rad(config.noise_scale * config.camera_pose_noise_deg);
+  std::mt19937_64 position_rng(streamSeed(config.seed, 9));
+  const double sigma_p = config.noise_scale * config.camera_pose_position_noise_m;
   std::vector<CameraOrientation> out;
   out.reserve(frame_times.size());
   const Eigen::Matrix3d R_target_world = trajectory.R_world_target().transpose();
@@ -138,9 +140,11 @@ std::vector<CameraOrientation> simulateCameraOrientations(const SimulationConfig
     o.capture_s = t;
     o.stamp_s = t + config.camera_time_offset_s;
     o.R_target_cam_true = R_target_world * st.R_world_cam;
-    o.p_target_cam = R_target_world * (st.p_world_cam - trajectory.p_world_target());
+    o.p_target_cam_true = R_target_world * (st.p_world_cam - trajectory.p_world_target());
     const Eigen::Vector3d n(unit(rng), unit(rng), unit(rng));
     o.R_target_cam = o.R_target_cam_true * expSO3(sigma * n);
+    const Eigen::Vector3d m(unit(position_rng), unit(position_rng), unit(position_rng));
+    o.p_target_cam = o.p_target_cam_true + o.R_target_cam_true * (sigma_p * m);
     out.push_back(o);
   }
   return out;
@@ -250,6 +254,7 @@ std::string truthYaml(const SimulationRun& run) {
     << "\n  pixel_noise_sigma: " << c.noise_scale * c.pixel_noise_sigma
     << "\n  motion_blur_exposure_s: " << c.motion_blur_exposure_s << "\n";
   if (c.camera_pose) {
+    o << "  pose_position_noise_m: " << c.noise_scale * c.camera_pose_position_noise_m << "\n";
     o << "  pose_noise_deg: " << c.noise_scale * c.camera_pose_noise_deg
       << "  # 1-sigma per axis of the camera_pose orientations\n";
   }

@@ -322,6 +322,9 @@ const std::vector<Key>& simulateBagOptionTable() {
       number<double>("--camera-pose-noise-deg", CIA_MEMBER(config.camera_pose_noise_deg),
                      within(0, 10), "deg",
                      "1-sigma orientation noise per axis of --camera-pose (x --noise-scale)"),
+      number<double>("--camera-pose-position-noise-m",
+                     CIA_MEMBER(config.camera_pose_position_noise_m), within(0, 0.1), "m",
+                     "1-sigma position noise per camera axis of --camera-pose (x --noise-scale)"),
       // ROS names, time base, bag.
       textKey<Options>("--imu-topic", CIA_MEMBER(config.imu_topic), "a topic name",
                        "IMU topic (a relative name is made global)"),

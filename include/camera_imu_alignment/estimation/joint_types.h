@@ -62,7 +62,7 @@ struct MotionFrame {
   Eigen::Matrix3d R_target_cam = Eigen::Matrix3d::Identity();
   /// Covariance of R_target_cam (rad^2, camera axes, right perturbation), e.g. PnP's.
   Eigen::Matrix3d cov_cam_rad2 = Eigen::Matrix3d::Zero();
-  /// The camera's centre in the target frame (m), when known (PnP, camera_pose): the velocities
+  /// The camera's centre in the target frame (m), when known (PnP, camera_pose): the positions
   /// the acceleration model needs (JointSettings::motion_accel_link_s).
   std::optional<Eigen::Vector3d> p_target_cam_m;
   /// The PnP fit it came from: RMS reprojection error (px) over reprojection_dof = 2 N - 6
@@ -83,16 +83,22 @@ struct GyroStream {
   double accel_noise_density_m_s2_sqrt_hz = 0;  ///< measured white noise (m/s^2/sqrt(Hz))
 };
 
-/// The accelerometer during motion between two motion nodes (set by the estimator): gravity plus
-/// the rig's acceleration, against the change of the IMU's velocity the camera's positions give.
+/// The accelerometer during motion between two keyframes (set by the estimator): motion nodes
+/// with a camera position about JointSettings::motion_accel_link_s apart, consecutive in a chain.
+/// Each keyframe has the IMU's velocity and the camera centre's position as states, the position
+/// measured by the camera; the accelerometer, rotated by the gyro from `from` and integrated once
+/// and twice over the link, must give the change of velocity and of position (VIO's
+/// preintegration), with gravity and the lever arm.
 struct AccelLink {
-  int from_pose = 0, to_pose = 0;  ///< motion nodes (JointProblem::poses), from < to
-  GyroStream samples;              ///< gyro and accelerometer over the interval and a margin
-  /// The velocities of the camera centre at the two nodes (target frame, m/s), from
-  /// the camera positions around them, and their 1-sigma per axis.
+  int from_pose = 0, to_pose = 0;  ///< keyframes (JointProblem::poses), from < to
+  GyroStream samples;              ///< gyro and accelerometer over [from, to] and a margin
+  /// The camera centre measured at the two keyframes (target frame, m).
+  Eigen::Vector3d p_from_target_m = Eigen::Vector3d::Zero(),
+                  p_to_target_m = Eigen::Vector3d::Zero();
+  /// Start values of the velocity at the two keyframes (target frame, m/s): central differences
+  /// of the chain's keyframe positions.
   Eigen::Vector3d v_from_target_m_s = Eigen::Vector3d::Zero(),
                   v_to_target_m_s = Eigen::Vector3d::Zero();
-  double velocity_sigma_m_s = 0;
 };
 
 /// The camera's rotation between two poses measured without a target (vision/scene_rotation.h):
@@ -261,11 +267,10 @@ struct JointSettings {
   /// Motion nodes further than this (s) from the next node or rest are linked to it only when
   /// the gyro covers the gap: beyond it the chain breaks (the target was out of view).
   double motion_max_link_s = 2.0;
-  /// The acceleration model: the accelerometer between motion nodes about this far apart (s)
-  /// against the change of velocity from the camera's positions; 0: the accelerometer is used at
-  /// rests only. Longer links: the velocities' noise weighs less against gravity x duration.
+  /// The acceleration model (AccelLink): keyframes about this far apart (s), the accelerometer
+  /// between them against their velocity and position; 0: the accelerometer is used at rests only.
   double motion_accel_link_s = 1.0;
-  /// 1-sigma (m) of a camera position (PnP, camera_pose) for the velocities by central difference.
+  /// 1-sigma (m) of each axis of a camera position (PnP, camera_pose) in the acceleration model.
   double camera_position_sigma_m = 1e-3;
   /// 1-sigma (m) of the prior on each axis of the IMU's position in the camera frame (the lever
   /// arm the acceleration model needs; estimated with it).

@@ -98,6 +98,9 @@ struct SimulationConfig {
   /// 1-sigma noise per axis (deg) of the camera orientations R_target_cam published as
   /// camera_pose (cameraOrientations in simulation_run.h): R_true * Exp(n), n in the camera frame
   double camera_pose_noise_deg = 0.02;
+  /// 1-sigma noise per axis (m) of those camera_pose positions p_target_cam, in the camera frame
+  /// (PnP's at 0.5-1 m from a board: a few tenths of a millimetre); noise_scale applies.
+  double camera_pose_position_noise_m = 0.3e-3;
   double blur_sigma_px = 0.6;           ///< Gaussian optical blur
   double pixel_noise_sigma = 1.5;       ///< grey levels (0-255), before noise_scale
   int supersample = 3;                  ///< samples per pixel along each axis

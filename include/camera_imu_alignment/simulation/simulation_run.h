@@ -43,7 +43,10 @@ struct CameraOrientation {
   /// frame, sigma = config.noise_scale * config.camera_pose_noise_deg (random stream 7).
   Eigen::Matrix3d R_target_cam = Eigen::Matrix3d::Identity();
   Eigen::Matrix3d R_target_cam_true = Eigen::Matrix3d::Identity();  ///< at capture_s
-  Eigen::Vector3d p_target_cam = Eigen::Vector3d::Zero();           ///< true centre (m), no noise
+  /// Camera centre (m) with the noise: p_true + R_target_cam_true m, m ~ N(0, sigma_p^2 I) in the
+  /// camera frame, sigma_p = config.noise_scale * config.camera_pose_position_noise_m (stream 9).
+  Eigen::Vector3d p_target_cam = Eigen::Vector3d::Zero();
+  Eigen::Vector3d p_target_cam_true = Eigen::Vector3d::Zero();  ///< at capture_s
 };
 
 /// The camera's orientation at every frame of `frame_times` (see CameraOrientation).

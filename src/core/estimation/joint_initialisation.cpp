@@ -86,7 +86,8 @@ State initialState(const JointProblem& problem, const Eigen::Matrix3d& R_cam_imu
       if (problem.poses[k].at_rest) up_target = R_target_imu[k] * problem.poses[k].accel_mean_m_s2;
     }
   }
-  // Without rests, up from the accelerometer links: R_target_imu int f dt = dv_target + up g T.
+  // Without rests, up from the accelerometer links: R_target_imu_from int f dt = dv_target + up g T
+  // (the keyframes' start velocities).
   if (!(up_target.norm() > 1e-6)) {
     for (const AccelLink& link : problem.accel_links) {
       const JointPose& from = problem.poses[link.from_pose];
@@ -96,7 +97,7 @@ State initialState(const JointProblem& problem, const Eigen::Matrix3d& R_cam_imu
       const AccelLinkIntegral in =
           integrateAccelLink(link.samples, from.start_s, problem.poses[link.to_pose].start_s,
                              Eigen::Matrix3d::Identity(), b, b);
-      up_target += projectToSO3(from.R_target_cam) * state.R_cam_imu_0 * in.dv0 -
+      up_target += projectToSO3(from.R_target_cam) * state.R_cam_imu_0 * in.d0[0] -
                    (link.v_to_target_m_s - link.v_from_target_m_s);
     }
   }

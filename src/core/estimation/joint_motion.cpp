@@ -51,22 +51,6 @@ void copySamples(const GyroStream& gyro, double from, double to, GyroSegment* se
   segment->interval = true;
 }
 
-/// Central-difference velocity of the camera centre at frame k (target frame, m/s) and its
-/// 1-sigma per axis; empty without positions or with neighbours too far. (A fourth-order
-/// difference over k-2..k+2 was tried: on the simulator's waving sessions it gave larger errors,
-/// 0.046-0.137 deg against 0.025-0.080 over seeds 3-5 (measured before the node spacing took
-/// 0.1 s stamps as 0.1 s), with its larger noise gain.)
-std::optional<std::pair<Eigen::Vector3d, double>> frameVelocity(
-    const std::vector<MotionFrame>& frames, size_t k, double position_sigma_m) {
-  if (k == 0 || k + 1 >= frames.size()) return std::nullopt;
-  const MotionFrame& a = frames[k - 1];
-  const MotionFrame& b = frames[k + 1];
-  const double dt = b.stamp_s - a.stamp_s;
-  if (!a.p_target_cam_m || !b.p_target_cam_m || !(dt > 0.0) || dt > 0.25) return std::nullopt;
-  return std::make_pair(Eigen::Vector3d((*b.p_target_cam_m - *a.p_target_cam_m) / dt),
-                        std::sqrt(2.0) * position_sigma_m / dt);
-}
-
 /// True when the stream covers [from, to] (IMU clock) without a gap longer than max_gap.
 bool covers(const GyroStream& gyro, double from, double to, double max_gap) {
   if (gyro.stamps_s.size() < 2 || gyro.stamps_s.front() > from || gyro.stamps_s.back() < to) {
@@ -88,7 +72,8 @@ double medianInterval(const std::vector<double>& stamps) {
   return dt[dt.size() / 2];
 }
 
-/// Accelerometer links between motion nodes of one chain about motion_accel_link_s apart.
+/// Accelerometer links between consecutive keyframes of each chain of motion nodes (AccelLink):
+/// nodes with a camera position about motion_accel_link_s apart (at most twice that).
 void addAccelLinks(const JointProblem& problem, const std::vector<int>& frame_of_pose,
                    const JointSettings& settings, JointProblem* expanded) {
   const GyroStream& gyro = problem.motion_gyro;
@@ -98,44 +83,60 @@ void addAccelLinks(const JointProblem& problem, const std::vector<int>& frame_of
   }
   const double max_gap = std::max(0.1, 10.0 * medianInterval(gyro.stamps_s));
   const std::vector<JointPose>& poses = expanded->poses;
-  const auto velocityOf = [&](size_t k) {
-    return frame_of_pose[k] < 0
-               ? std::nullopt
-               : frameVelocity(problem.motion_frames, static_cast<size_t>(frame_of_pose[k]),
-                               settings.camera_position_sigma_m);
+  const auto positionOf = [&](size_t k) -> std::optional<Eigen::Vector3d> {
+    if (poses[k].at_rest || frame_of_pose[k] < 0) return std::nullopt;
+    return problem.motion_frames[static_cast<size_t>(frame_of_pose[k])].p_target_cam_m;
   };
-  size_t from = 0;
-  while (from < poses.size()) {
-    const auto v_from = velocityOf(from);
-    if (poses[from].at_rest || !v_from) {
-      ++from;
-      continue;
-    }
-    size_t to = from + 1;
-    bool linked = false;
-    for (; to < poses.size(); ++to) {
-      const double dt = poses[to].start_s - poses[from].start_s;
-      if (poses[to].at_rest || poses[to].group != poses[from].group ||
+  // The first node after `from` at least motion_accel_link_s later (at most twice that) in the
+  // same chain, with a position and the IMU's samples between; poses.size() when there is none.
+  const auto nextKeyframe = [&](size_t from) {
+    for (size_t k = from + 1; k < poses.size(); ++k) {
+      const double dt = poses[k].start_s - poses[from].start_s;
+      if (poses[k].at_rest || poses[k].group != poses[from].group ||
           dt > 2.0 * settings.motion_accel_link_s) {
         break;
       }
-      if (dt < settings.motion_accel_link_s) continue;
-      const auto v_to = velocityOf(to);
-      if (!v_to) continue;
-      const double t_from = poses[from].start_s, t_to = poses[to].start_s;
-      if (!covers(gyro, t_from - kSampleMargin, t_to + kSampleMargin, max_gap)) break;
-      AccelLink link;
-      link.from_pose = static_cast<int>(from);
-      link.to_pose = static_cast<int>(to);
-      copyStream(gyro, t_from, t_to, &link.samples);
-      link.v_from_target_m_s = v_from->first;
-      link.v_to_target_m_s = v_to->first;
-      link.velocity_sigma_m_s = std::max(v_from->second, v_to->second);
-      expanded->accel_links.push_back(link);
-      linked = true;
-      break;
+      if (dt < settings.motion_accel_link_s || !positionOf(k)) continue;
+      return covers(gyro, poses[from].start_s - kSampleMargin, poses[k].start_s + kSampleMargin,
+                    max_gap)
+                 ? k
+                 : poses.size();
     }
-    from = linked ? to : from + 1;
+    return poses.size();
+  };
+  // Chains of keyframes, then a link between each two consecutive ones.
+  size_t start = 0;
+  while (start < poses.size()) {
+    if (!positionOf(start)) {
+      ++start;
+      continue;
+    }
+    std::vector<size_t> chain = {start};
+    for (size_t next = nextKeyframe(start); next < poses.size(); next = nextKeyframe(next)) {
+      chain.push_back(next);
+    }
+    if (chain.size() < 2) {
+      ++start;
+      continue;
+    }
+    std::vector<Eigen::Vector3d> p(chain.size()), v(chain.size());
+    for (size_t i = 0; i < chain.size(); ++i) p[i] = *positionOf(chain[i]);
+    for (size_t i = 0; i < chain.size(); ++i) {
+      const size_t a = i == 0 ? 0 : i - 1, b = std::min(i + 1, chain.size() - 1);
+      v[i] = (p[b] - p[a]) / (poses[chain[b]].start_s - poses[chain[a]].start_s);
+    }
+    for (size_t i = 0; i + 1 < chain.size(); ++i) {
+      AccelLink link;
+      link.from_pose = static_cast<int>(chain[i]);
+      link.to_pose = static_cast<int>(chain[i + 1]);
+      copyStream(gyro, poses[chain[i]].start_s, poses[chain[i + 1]].start_s, &link.samples);
+      link.p_from_target_m = p[i];
+      link.p_to_target_m = p[i + 1];
+      link.v_from_target_m_s = v[i];
+      link.v_to_target_m_s = v[i + 1];
+      expanded->accel_links.push_back(link);
+    }
+    start = chain.back() + 1;
   }
 }
 
@@ -331,12 +332,28 @@ AccelLinkIntegral integrateAccelLink(const GyroStream& samples, double t_from_s,
   const auto interpolate = [&](const std::vector<Eigen::Vector3d>& values, double t) {
     return interpolateSamples(stamps, values, n, t);
   };
+  // The calibrated rate at t and its derivative with respect to theta (T_g row-major, b_from,
+  // b_to): d(T_g^-1 u)/dT_g(i, j) = -T_g^-1 e_i omega_j.
+  Eigen::Matrix<double, 3, 15> rate_jacobian;
   const auto rateAt = [&](double t) {
     const double s = std::clamp((t - t_from_s) / span, 0.0, 1.0);
-    return Eigen::Vector3d(T_g_inverse *
-                           (interpolate(samples.gyro_rad_s, t) - (b_from + s * (b_to - b_from))));
+    const Eigen::Vector3d omega =
+        T_g_inverse * (interpolate(samples.gyro_rad_s, t) - (b_from + s * (b_to - b_from)));
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) rate_jacobian.col(3 * i + j) = -T_g_inverse.col(i) * omega(j);
+    }
+    rate_jacobian.middleCols<3>(9) = -(1.0 - s) * T_g_inverse;
+    rate_jacobian.rightCols<3>() = -s * T_g_inverse;
+    return omega;
+  };
+  // Right Jacobian of SO(3) to second order (steps of a few milliradians).
+  const auto rightJacobian = [](const Eigen::Vector3d& phi) {
+    const Eigen::Matrix3d K = skew(phi);
+    return Eigen::Matrix3d(Eigen::Matrix3d::Identity() - 0.5 * K + K * K / 6.0);
   };
   Eigen::Matrix3d delta_R = Eigen::Matrix3d::Identity();
+  // d DeltaR / d theta as a right perturbation: DeltaR(theta + d) = DeltaR Exp(phi d).
+  Eigen::Matrix<double, 3, 15> phi = Eigen::Matrix<double, 3, 15>::Zero();
   double t = t_from_s;
   size_t i = static_cast<size_t>(std::upper_bound(stamps.begin(), stamps.begin() + n, t_from_s) -
                                  stamps.begin());
@@ -344,22 +361,39 @@ AccelLinkIntegral integrateAccelLink(const GyroStream& samples, double t_from_s,
     const double next = i < n ? std::min(stamps[i], t_to_s) : t_to_s;
     if (next > t) {
       const double dt = next - t, mid = 0.5 * (t + next);
+      // Velocity: weight 1; position: the double integral, weight (to - t).
+      const double w[2] = {1.0, t_to_s - mid};
       const Eigen::Vector3d rate = rateAt(mid);
-      const Eigen::Matrix3d R_mid = delta_R * expSO3(0.5 * dt * rate);
+      const Eigen::Vector3d half = 0.5 * dt * rate;
+      const Eigen::Matrix3d E_half = expSO3(half);
+      const Eigen::Matrix3d R_mid = delta_R * E_half;
+      const Eigen::Matrix<double, 3, 15> phi_mid =
+          E_half.transpose() * phi + rightJacobian(half) * (0.5 * dt) * rate_jacobian;
       const Eigen::Vector3d a = interpolate(samples.accel_m_s2, mid);
-      out.dv0 += dt * R_mid * a;
-      out.bias_jacobian += dt * R_mid;
-      for (int s = 0; s < 3; ++s) {
-        for (int u = 0; u < 3; ++u) out.per_entry.col(3 * s + u) += dt * R_mid.col(s) * a(u);
+      // d(R_mid a) = -R_mid [a]x phi_mid d.
+      const Eigen::Matrix<double, 3, 15> turned = -R_mid * skew(a) * phi_mid;
+      for (int k = 0; k < 2; ++k) {
+        out.d0[k] += w[k] * dt * R_mid * a;
+        out.bias_jacobian[k] += w[k] * dt * R_mid;
+        out.gyro_jacobian[k] += w[k] * dt * turned;
+        for (int s = 0; s < 3; ++s) {
+          for (int u = 0; u < 3; ++u) {
+            out.per_entry[k].col(3 * s + u) += w[k] * dt * R_mid.col(s) * a(u);
+          }
+        }
       }
-      delta_R = delta_R * expSO3(dt * rate);
+      const Eigen::Vector3d step = dt * rate;
+      const Eigen::Matrix3d E = expSO3(step);
+      phi = E.transpose() * phi + rightJacobian(step) * dt * rate_jacobian;
+      delta_R = delta_R * E;
     }
     t = next;
     ++i;
   }
-  out.rate_from = rateAt(t_from_s);
-  out.rate_to = rateAt(t_to_s);
   out.duration_s = span;
+  for (int k = 0; k < 9; ++k) out.theta0_minus_identity(k) = T_g(k / 3, k % 3) - (k % 4 == 0);
+  out.theta0_minus_identity.segment<3>(9) = b_from;
+  out.theta0_minus_identity.segment<3>(12) = b_to;
   return out;
 }
 

@@ -29,24 +29,27 @@ std::string validateMotion(const JointProblem& problem);
 ExpandedProblem expandMotion(const JointProblem& problem, const JointSettings& settings);
 
 /// An accelerometer link preintegrated at the gyro model and time offset of a pass, in the IMU
-/// frame at the link's start: dv0 = int DeltaR(t) a(t) dt (raw accelerometer), bias_jacobian = int
-/// DeltaR dt, and per_entry(r, 3 s + u) = int DeltaR(t)(r, s) a_u(t) dt, so that the integral of
-/// DeltaR (T_a^-1 (a - b)) ~ dv0 - bias_jacobian b - sum_su P_su per_entry(:, 3 s + u) with
-/// P = T_a - I (first order). rate_from/rate_to: the calibrated body rates at the ends (rad/s).
+/// frame at its start. Index k = 0 is the change of velocity (weight 1), k = 1 the change of
+/// position beyond the starting velocity (weight to - t): d0[k] = int w_k DeltaR(t) a(t) dt (raw
+/// accelerometer), bias_jacobian[k] = int w_k DeltaR dt, per_entry[k](r, 3 s + u) = int w_k
+/// DeltaR(t)(r, s) a_u(t) dt, so that int w_k DeltaR (T_a^-1 (a - b)) dt ~ d0[k] -
+/// bias_jacobian[k] b - sum_su P_su per_entry[k](:, 3 s + u) with P = T_a - I (first order).
 struct AccelLinkIntegral {
-  Eigen::Vector3d dv0 = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d bias_jacobian = Eigen::Matrix3d::Zero();
-  Eigen::Matrix<double, 3, 9> per_entry = Eigen::Matrix<double, 3, 9>::Zero();
-  Eigen::Vector3d rate_from = Eigen::Vector3d::Zero(), rate_to = Eigen::Vector3d::Zero();
-  double duration_s = 0;
-  /// d dv0 / d theta, theta = [T_g row-major (9), gyro bias at the start (3), at the end (3)]
-  /// (numerical), and theta at which it was taken (T_g entries with I subtracted): the
-  /// accelerometer's integral follows the gyro model within a pass.
-  Eigen::Matrix<double, 3, 15> gyro_jacobian = Eigen::Matrix<double, 3, 15>::Zero();
+  Eigen::Vector3d d0[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  Eigen::Matrix3d bias_jacobian[2] = {Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};
+  Eigen::Matrix<double, 3, 9> per_entry[2] = {Eigen::Matrix<double, 3, 9>::Zero(),
+                                              Eigen::Matrix<double, 3, 9>::Zero()};
+  double duration_s = 0;  ///< to - from
+  /// d d0[k] / d theta, theta = [T_g row-major (9), gyro bias at the start (3), at the end (3)]
+  /// (propagated with the integral, as VIO's preintegration does for the bias), and theta at which
+  /// it was taken (T_g entries with I subtracted): the accelerometer's integral follows the gyro
+  /// model within a pass.
+  Eigen::Matrix<double, 3, 15> gyro_jacobian[2] = {Eigen::Matrix<double, 3, 15>::Zero(),
+                                                   Eigen::Matrix<double, 3, 15>::Zero()};
   Eigen::Matrix<double, 15, 1> theta0_minus_identity = Eigen::Matrix<double, 15, 1>::Zero();
 };
 
-/// The link between t_from_s and t_to_s (IMU clock) under T_g and the gyro biases at its ends.
+/// The link over [t_from_s, t_to_s] (IMU clock) under T_g and the gyro biases at its ends.
 AccelLinkIntegral integrateAccelLink(const GyroStream& samples, double t_from_s, double t_to_s,
                                      const Eigen::Matrix3d& T_g, const Eigen::Vector3d& b_from,
                                      const Eigen::Vector3d& b_to);

@@ -1,5 +1,6 @@
 // The Ceres problem of the joint estimator: residuals, priors and what is held (joint_estimator.h).
 #include <ceres/autodiff_cost_function.h>
+#include <ceres/dynamic_autodiff_cost_function.h>
 #include <ceres/loss_function.h>
 #include <ceres/manifold.h>
 #include <ceres/normal_prior.h>
@@ -379,43 +380,119 @@ class Builder {
            -1, -1, static_cast<int>(free_entries.size()));
   }
 
-  /// The accelerometer between motion nodes, with its bias during motion and the lever arm.
+  /// The accelerometer between keyframes (AccelLink): the keyframes' position and velocity states
+  /// with the camera's positions, the bias during the links and the lever arm.
   void addAccelLinks(const std::vector<AccelLinkIntegral>& integrals) {
     const ImuModelPriors& p = settings_.priors;
-    addBlock(state_.motion_accel_bias.data(), 3);
-    record(ceres_.AddResidualBlock(
-               maskedPrior(3, {0, 1, 2}, std::vector<double>(3, p.accel_bias_m_s2)), nullptr,
-               state_.motion_accel_bias.data()),
-           -1, -1, 3);
+    const size_t links = problem_.accel_links.size();
+    // Start values (kept between the passes): the measured positions and the central
+    // differences of the keyframes' positions.
+    if (state_.link_accel_bias.size() != links) state_.link_accel_bias.assign(links, {0, 0, 0});
+    if (state_.keyframe_pv.size() != problem_.poses.size()) {
+      state_.keyframe_pv.assign(problem_.poses.size(), {0, 0, 0, 0, 0, 0});
+      for (const AccelLink& link : problem_.accel_links) {
+        setKeyframe(link.from_pose, link.p_from_target_m, link.v_from_target_m_s);
+        setKeyframe(link.to_pose, link.p_to_target_m, link.v_to_target_m_s);
+      }
+    }
+    // Each keyframe's camera centre, measured once.
+    std::vector<bool> measured(problem_.poses.size(), false);
+    const auto measure = [&](int pose, const Eigen::Vector3d& p_target_m) {
+      if (measured[static_cast<size_t>(pose)]) return;
+      measured[static_cast<size_t>(pose)] = true;
+      double* block = state_.keyframe_pv[static_cast<size_t>(pose)].data();
+      addBlock(block, 6);
+      ceres::Matrix A = ceres::Matrix::Zero(3, 6);
+      A.leftCols(3) = ceres::Matrix::Identity(3, 3) / settings_.camera_position_sigma_m;
+      ceres::Vector b = ceres::Vector::Zero(6);
+      b.head(3) = p_target_m;
+      record(ceres_.AddResidualBlock(new ceres::NormalPrior(A, b), nullptr, block), pose, -1, 3);
+    };
+    // The bias during the links: the first with the bias prior, each next one a random walk from
+    // the one before (link starts dt apart), as the rests' biases.
+    for (size_t j = 0; j < links; ++j) {
+      addBlock(state_.link_accel_bias[j].data(), 3);
+      if (j == 0) {
+        record(ceres_.AddResidualBlock(
+                   maskedPrior(3, {0, 1, 2}, std::vector<double>(3, p.accel_bias_m_s2)), nullptr,
+                   state_.link_accel_bias[j].data()),
+               -1, -1, 3);
+        continue;
+      }
+      const double dt = std::max(
+          startOf(problem_.accel_links[j]) - startOf(problem_.accel_links[j - 1]), kMinWalkDt);
+      auto* walk = new ceres::AutoDiffCostFunction<BiasWalkResidual, 3, 3, 3>(
+          new BiasWalkResidual{1.0 / (p.accel_bias_walk_m_s2_sqrt_s * std::sqrt(dt))});
+      record(ceres_.AddResidualBlock(walk, nullptr, state_.link_accel_bias[j - 1].data(),
+                                     state_.link_accel_bias[j].data()),
+             -1, -1, 3);
+    }
     addBlock(state_.lever_arm_m.data(), 3);
     record(ceres_.AddResidualBlock(
                maskedPrior(3, {0, 1, 2}, std::vector<double>(3, settings_.lever_arm_prior_m)),
                nullptr, state_.lever_arm_m.data()),
            -1, -1, 3);
-    for (size_t j = 0; j < problem_.accel_links.size(); ++j) {
+    const double g = settings_.gravity_m_s2;
+    for (size_t j = 0; j < links; ++j) {
       const AccelLink& link = problem_.accel_links[j];
       const AccelLinkIntegral& in = integrals[j];
       const size_t from = static_cast<size_t>(link.from_pose),
                    to = static_cast<size_t>(link.to_pose);
-      const Eigen::Matrix3d R_tc_from = projectToSO3(problem_.poses[from].R_target_cam);
-      const Eigen::Matrix3d R_tc_to = projectToSO3(problem_.poses[to].R_target_cam);
-      const Eigen::Matrix3d& X0 = cameraImu0(from);
-      const double density = link.samples.accel_noise_density_m_s2_sqrt_hz;
-      const double variance = density * density * in.duration_s +
-                              2.0 * link.velocity_sigma_m_s * link.velocity_sigma_m_s;
-      auto* cost = new ceres::AutoDiffCostFunction<AccelLinkResidual, 3, 3, 3, 3, 6, 3, 3, 9, 3, 3>(
-          new AccelLinkResidual{
-              targetCam(from), X0, state_.R_world_target_0, in.dv0, in.bias_jacobian, in.per_entry,
-              link.v_to_target_m_s - link.v_from_target_m_s, R_tc_from * skew(X0 * in.rate_from),
-              R_tc_to * skew(X0 * in.rate_to), settings_.gravity_m_s2, in.duration_s,
-              1.0 / std::sqrt(variance), settings_.accel_matrix_form, in.gyro_jacobian,
-              in.theta0_minus_identity});
-      const std::vector<double*> blocks = {
-          state_.e_T.data(),          cameraImuIncrement(from),        state_.delta[from].data(),
-          state_.accel_matrix.data(), state_.motion_accel_bias.data(), state_.lever_arm_m.data(),
-          state_.gyro_matrix.data(),  state_.gyro_bias[from].data(),   state_.gyro_bias[to].data()};
+      measure(link.from_pose, link.p_from_target_m);
+      measure(link.to_pose, link.p_to_target_m);
+      // Per axis, [r_v, r_p]: the accelerometer's white noise integrated once and twice, and the
+      // gyro's turning the integrated specific force (about g; across it, counted on every axis).
+      const double T = in.duration_s;
+      const double a2 = std::pow(link.samples.accel_noise_density_m_s2_sqrt_hz, 2);
+      const double r2 = std::pow(link.samples.noise_density_rad_s_sqrt_hz * g, 2);
+      Eigen::Matrix2d covariance;
+      covariance << a2 * T + r2 * std::pow(T, 3) / 3.0,
+          a2 * T * T / 2.0 + r2 * std::pow(T, 4) / 8.0,
+          a2 * T * T / 2.0 + r2 * std::pow(T, 4) / 8.0,
+          a2 * std::pow(T, 3) / 3.0 + r2 * std::pow(T, 5) / 20.0;
+      const Eigen::Matrix2d L = covariance.llt().matrixL();
+      auto* residual = new AccelLinkResidual{targetCam(from),
+                                             cameraImu0(from),
+                                             state_.R_world_target_0,
+                                             {in.d0[0], in.d0[1]},
+                                             {in.bias_jacobian[0], in.bias_jacobian[1]},
+                                             {in.per_entry[0], in.per_entry[1]},
+                                             {in.gyro_jacobian[0], in.gyro_jacobian[1]},
+                                             in.theta0_minus_identity,
+                                             projectToSO3(problem_.poses[from].R_target_cam),
+                                             projectToSO3(problem_.poses[to].R_target_cam),
+                                             g,
+                                             T,
+                                             L.inverse(),
+                                             settings_.accel_matrix_form};
+      auto* cost = new ceres::DynamicAutoDiffCostFunction<AccelLinkResidual, 16>(residual);
+      for (int size : AccelLinkResidual::kBlockSizes) cost->AddParameterBlock(size);
+      cost->SetNumResiduals(6);
+      const std::vector<double*> blocks = {state_.e_T.data(),
+                                           cameraImuIncrement(from),
+                                           state_.delta[from].data(),
+                                           state_.accel_matrix.data(),
+                                           state_.link_accel_bias[j].data(),
+                                           state_.lever_arm_m.data(),
+                                           state_.gyro_matrix.data(),
+                                           state_.gyro_bias[from].data(),
+                                           state_.gyro_bias[to].data(),
+                                           state_.keyframe_pv[from].data(),
+                                           state_.keyframe_pv[to].data()};
       record(ceres_.AddResidualBlock(cost, loss_, blocks), static_cast<int>(from),
-             static_cast<int>(to), 3);
+             static_cast<int>(to), 6);
+    }
+  }
+
+  double startOf(const AccelLink& link) const {
+    return problem_.poses[static_cast<size_t>(link.from_pose)].start_s;
+  }
+
+  void setKeyframe(int pose, const Eigen::Vector3d& p_target_m, const Eigen::Vector3d& v_m_s) {
+    std::array<double, 6>& pv = state_.keyframe_pv[static_cast<size_t>(pose)];
+    for (int i = 0; i < 3; ++i) {
+      pv[static_cast<size_t>(i)] = p_target_m(i);
+      pv[static_cast<size_t>(3 + i)] = v_m_s(i);
     }
   }
 

@@ -133,6 +133,11 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
           is_node_bias || (!problem.poses[k].at_rest && block == state.gyro_bias[k].data());
     }
     if (is_node_bias) continue;
+    // The acceleration model's keyframe states and link biases: many, and not reported.
+    bool is_link_state = false;
+    for (const auto& pv : state.keyframe_pv) is_link_state = is_link_state || block == pv.data();
+    for (const auto& b : state.link_accel_bias) is_link_state = is_link_state || block == b.data();
+    if (is_link_state) continue;
     requested[block] = ceres_problem->ParameterBlockSize(block);
     pairs.emplace_back(block, block);
   }

@@ -278,47 +278,72 @@ Vector3<T> worldFromImu(const Eigen::Matrix3d& T0_target_cam, const Eigen::Matri
   return a;
 }
 
-/// The accelerometer between two motion nodes (AccelLink, joint_motion.h): the IMU's change of
-/// velocity in W from the accelerometer, R_world_imu_from int DeltaR T_a^-1 (a - b) dt + g_world T,
-/// against the one the camera's positions give, R_world_target (v_imu_to - v_imu_from) with
-/// v_imu = v_cam + R_target_cam (w_cam x l), l the IMU's position in the camera frame (m).
+/// The accelerometer between two keyframes (AccelLink), preintegrated from `from`: with R_w the
+/// world-from-IMU rotation at `from`, f_k = int w_k DeltaR T_a^-1 (a - b) dt (k = 0 velocity,
+/// k = 1 position), the residuals per axis are
+///   r_v = R_w f_0 - g z T - R_world_target (v_to - v_from)
+///   r_p = R_w f_1 - g z T^2 / 2 - R_world_target (p_to - p_from - v_from T)
+/// with v the IMU's velocity and p = p_cam + R_target_cam l the IMU's position (target frame; l the
+/// IMU's position in the camera frame, p_cam the keyframe's camera centre state), whitened per axis
+/// by the 2x2 covariance of [r_v, r_p]. Parameter blocks: e_T, e_X, delta_from, accel_matrix,
+/// accel_bias, lever_arm, gyro_matrix, gyro_bias_from, gyro_bias_to, pv_from, pv_to (p_cam, v).
 struct AccelLinkResidual {
   Eigen::Matrix3d T0_target_cam_from, X0, T0;  // T0 R_target_cam_from, X0, T0 = R_world_target_0
-  Eigen::Vector3d dv0;
-  Eigen::Matrix3d bias_jacobian;
-  Eigen::Matrix<double, 3, 9> per_entry;
-  Eigen::Vector3d v_cam_difference_target;  // v_cam_to - v_cam_from (target frame, m/s)
-  Eigen::Matrix3d lever_from, lever_to;     // R_target_cam_k [w_cam_k]x: velocity = lever_k l
-  double gravity_m_s2, duration_s, inverse_sigma;
-  AccelMatrixForm form;
-  Eigen::Matrix<double, 3, 15> gyro_jacobian;  // d dv0 / d theta (T_g, bias from, bias to)
+  Eigen::Vector3d d0[2];
+  Eigen::Matrix3d bias_jacobian[2];
+  Eigen::Matrix<double, 3, 9> per_entry[2];
+  Eigen::Matrix<double, 3, 15> gyro_jacobian[2];  // d d0[k] / d theta (T_g, bias from, bias to)
   Eigen::Matrix<double, 15, 1> theta0_minus_identity;
+  Eigen::Matrix3d R_tc_from, R_tc_to;  // the keyframes' measured camera orientations
+  double gravity_m_s2, duration_s;
+  Eigen::Matrix2d whitening;  // L^-1 of each axis' [r_v, r_p] covariance
+  AccelMatrixForm form;
+
+  static constexpr int kBlocks = 11;
+  static constexpr int kBlockSizes[kBlocks] = {3, 3, 3, 6, 3, 3, 9, 3, 3, 6, 6};
 
   template <typename T>
-  bool operator()(const T* e_T, const T* e_X, const T* delta, const T* accel_matrix,
-                  const T* accel_bias, const T* lever, const T* gyro_matrix, const T* gyro_from,
-                  const T* gyro_to, T* residual) const {
-    const Matrix3<T> P = accelMatrix(accel_matrix, form) - Matrix3<T>::Identity();
-    const Eigen::Map<const Vector3<T>> b(accel_bias);
+  bool operator()(T const* const* parameters, T* residual) const {
+    const T* e_T = parameters[0];
+    const T* e_X = parameters[1];
+    const T* delta = parameters[2];
+    const Matrix3<T> P = accelMatrix(parameters[3], form) - Matrix3<T>::Identity();
+    const Eigen::Map<const Vector3<T>> b(parameters[4]);
+    const Eigen::Map<const Vector3<T>> l(parameters[5]);
     Eigen::Matrix<T, 15, 1> dtheta;
-    for (int i = 0; i < 9; ++i) dtheta(i) = gyro_matrix[i] - T(theta0_minus_identity(i));
+    for (int i = 0; i < 9; ++i) dtheta(i) = parameters[6][i] - T(theta0_minus_identity(i));
     for (int i = 0; i < 3; ++i) {
-      dtheta(9 + i) = gyro_from[i] - T(theta0_minus_identity(9 + i));
-      dtheta(12 + i) = gyro_to[i] - T(theta0_minus_identity(12 + i));
+      dtheta(9 + i) = parameters[7][i] - T(theta0_minus_identity(9 + i));
+      dtheta(12 + i) = parameters[8][i] - T(theta0_minus_identity(12 + i));
     }
-    Vector3<T> f = dv0.cast<T>() + gyro_jacobian.cast<T>() * dtheta - bias_jacobian.cast<T>() * b;
-    for (int s = 0; s < 3; ++s) {
-      for (int u = 0; u < 3; ++u) f -= P(s, u) * per_entry.col(3 * s + u).cast<T>();
+    const T* pv_from = parameters[9];
+    const T* pv_to = parameters[10];
+    const Vector3<T> v_from(pv_from[3], pv_from[4], pv_from[5]);
+    const Vector3<T> v_to(pv_to[3], pv_to[4], pv_to[5]);
+    const Vector3<T> p_from =
+        Vector3<T>(pv_from[0], pv_from[1], pv_from[2]) + R_tc_from.cast<T>() * l;
+    const Vector3<T> p_to = Vector3<T>(pv_to[0], pv_to[1], pv_to[2]) + R_tc_to.cast<T>() * l;
+    const T dt(duration_s);
+    const Vector3<T> change[2] = {v_to - v_from, p_to - p_from - v_from * dt};
+    const T gravity[2] = {T(gravity_m_s2) * dt, T(0.5 * gravity_m_s2) * dt * dt};
+    Vector3<T> r[2];
+    for (int k = 0; k < 2; ++k) {
+      Vector3<T> f =
+          d0[k].cast<T>() + gyro_jacobian[k].cast<T>() * dtheta - bias_jacobian[k].cast<T>() * b;
+      for (int s = 0; s < 3; ++s) {
+        for (int u = 0; u < 3; ++u) f -= P(s, u) * per_entry[k].col(3 * s + u).cast<T>();
+      }
+      Vector3<T> predicted = worldFromImu(T0_target_cam_from, X0, e_T, delta, e_X, f);
+      predicted(2) -= gravity[k];
+      const Vector3<T> rotated = T0.cast<T>() * change[k];
+      Vector3<T> measured;
+      ceres::AngleAxisRotatePoint(e_T, rotated.data(), measured.data());
+      r[k] = predicted - measured;
     }
-    Vector3<T> predicted = worldFromImu(T0_target_cam_from, X0, e_T, delta, e_X, f);
-    predicted(2) -= T(gravity_m_s2 * duration_s);
-    const Eigen::Map<const Vector3<T>> l(lever);
-    const Vector3<T> v_target =
-        v_cam_difference_target.cast<T>() + lever_to.cast<T>() * l - lever_from.cast<T>() * l;
-    const Vector3<T> v_rotated = T0.cast<T>() * v_target;
-    Vector3<T> measured;
-    ceres::AngleAxisRotatePoint(e_T, v_rotated.data(), measured.data());
-    for (int i = 0; i < 3; ++i) residual[i] = T(inverse_sigma) * (predicted(i) - measured(i));
+    for (int i = 0; i < 3; ++i) {
+      residual[i] = T(whitening(0, 0)) * r[0](i) + T(whitening(0, 1)) * r[1](i);
+      residual[3 + i] = T(whitening(1, 0)) * r[0](i) + T(whitening(1, 1)) * r[1](i);
+    }
     return true;
   }
 };

@@ -40,9 +40,13 @@ struct State {
   /// timeshift_cam_imu (s) and the value the gyro was last preintegrated at (motion nodes).
   std::array<double, 1> timeshift{};
   double timeshift_0 = 0;
-  /// The acceleration model (JointProblem::accel_links): the accelerometer bias during motion
-  /// (m/s^2) and the IMU's position in the camera frame (m).
-  std::array<double, 3> motion_accel_bias{}, lever_arm_m{};
+  /// The acceleration model (JointProblem::accel_links): the accelerometer bias during each link
+  /// (m/s^2; a random walk from link to link) and the IMU's position in the camera frame (m).
+  std::vector<std::array<double, 3>> link_accel_bias;
+  std::array<double, 3> lever_arm_m{};
+  /// Per pose, used at the links' keyframes: the camera centre (m) and the IMU's velocity (m/s),
+  /// both in the target frame.
+  std::vector<std::array<double, 6>> keyframe_pv;
 
   Eigen::Matrix3d gyroMatrix() const;  ///< T_g
   Eigen::Vector3d gyroBias(int pose) const;

@@ -319,30 +319,10 @@ std::vector<AccelLinkIntegral> integrateAccelLinks(const JointProblem& problem,
                                                    double timeshift) {
   std::vector<AccelLinkIntegral> out;
   const double shift = timeshift - problem.timeshift_initial_s;
-  constexpr double kStep = 1e-6;  // T_g entries and rad/s: far inside the linear range
   for (const AccelLink& link : problem.accel_links) {
-    const double from = problem.poses[link.from_pose].start_s + shift;
-    const double to = problem.poses[link.to_pose].start_s + shift;
-    const Eigen::Vector3d& b_from = biases[link.from_pose];
-    const Eigen::Vector3d& b_to = biases[link.to_pose];
-    AccelLinkIntegral base = integrateAccelLink(link.samples, from, to, T_g, b_from, b_to);
-    for (int i = 0; i < 15; ++i) {
-      Eigen::Matrix3d T = T_g;
-      Eigen::Vector3d bf = b_from, bt = b_to;
-      if (i < 9) {
-        T(i / 3, i % 3) += kStep;
-      } else if (i < 12) {
-        bf(i - 9) += kStep;
-      } else {
-        bt(i - 12) += kStep;
-      }
-      base.gyro_jacobian.col(i) =
-          (integrateAccelLink(link.samples, from, to, T, bf, bt).dv0 - base.dv0) / kStep;
-    }
-    for (int i = 0; i < 9; ++i) base.theta0_minus_identity(i) = T_g(i / 3, i % 3) - (i % 4 == 0);
-    base.theta0_minus_identity.segment<3>(9) = b_from;
-    base.theta0_minus_identity.segment<3>(12) = b_to;
-    out.push_back(base);
+    out.push_back(integrateAccelLink(link.samples, problem.poses[link.from_pose].start_s + shift,
+                                     problem.poses[link.to_pose].start_s + shift, T_g,
+                                     biases[link.from_pose], biases[link.to_pose]));
   }
   return out;
 }

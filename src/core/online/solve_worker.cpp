@@ -16,8 +16,8 @@ SolveOutput runSolveJob(SolveJob job, const PipelineSettings& pipeline,
     // one: the splits with fewer than min_poses_after poses after them in the last tested window
     // were only pending, so the reach is the untested poses plus min_poses_after - 1.
     MountChangeSettings remount = online.remount;
-    remount.max_poses_after = std::max(remount.max_poses_after,
-                                       job.poses_not_yet_tested + remount.min_poses_after - 1);
+    remount.max_poses_after =
+        std::max(remount.max_poses_after, job.poses_not_yet_tested + remount.min_poses_after - 1);
     out.mount_test =
         testMountChange(job.window.joint, *out.result.joint, jointSettingsOf(pipeline), remount);
   }
