@@ -158,7 +158,10 @@ TEST(SceneRemount, TwoDegreesAreFoundWithinThreeStopsAndTheNewMountEstimated) {
     // The estimate at the end (the poses after the remount): within 3 of its 1-sigma per camera
     // axis of the new mount (left perturbation, camera axes).
     const AlignmentResult& result = run->outcome.result;
-    ASSERT_EQ(result.status, SolveStatus::kOk) << what << ": " << result.message;
+    if (result.status != SolveStatus::kOk) {  // the other seeds still run (a Monte Carlo)
+      ADD_FAILURE() << what << ": final estimate: " << result.message;
+      continue;
+    }
     const Eigen::Matrix3d truth_after = truth.R_cam_imu_final();
     const Eigen::Vector3d error_deg =
         rad2deg(1.0) * logSO3(result.R_cam_imu * truth_after.transpose());

@@ -84,6 +84,12 @@ struct MountChangeCandidate {
   bool declarable = false;
   double change_deg = 0;  ///< angle between the two mounts' R_cam_imu
   bool solved = false;    ///< the two-mount solve succeeded
+  /// The camera's measurements determine the mounts well enough to test it: the mount before it
+  /// over-determined by that side's own (3 residuals per absolute orientation, 2 per relative
+  /// rotation within the side; more than 3), the one after a declarable split by its own and the
+  /// rotations across it (3 each). False: not solved (two natural-scene rests with one rotation
+  /// between them would take a wrong rotation for a mount of their own).
+  bool camera_overdetermined = true;
   /// Worst pose residual over max(1.5, 2.5 x median) in the two-mount solve; <= 1: fits every pose.
   double worst_pose_misfit = 0;
   bool fits_every_pose = false;
