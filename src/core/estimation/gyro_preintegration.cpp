@@ -1,5 +1,7 @@
 #include "camera_imu_alignment/estimation/gyro_preintegration.h"
 
+#include "gyro_accumulator.h"
+
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
@@ -62,53 +64,36 @@ std::vector<double> sampleIntervals(const std::vector<double>& stamps_s) {
   return dt;
 }
 
-namespace {
-
-/// Accumulates one step of rate `raw` (raw gyro, rad/s) held for dt at bias-ramp fraction s.
-struct Accumulator {
-  Eigen::Matrix3d T_g_inverse;
-  Eigen::Vector3d b_from, b_to;
-  Eigen::Matrix3d delta_R = Eigen::Matrix3d::Identity();
-  GyroPreintegrationJacobian J = GyroPreintegrationJacobian::Zero();
-  double duration_s = 0.0;
-
-  Eigen::Vector3d rateOf(const Eigen::Vector3d& raw, double s) const {
-    return T_g_inverse * (raw - (b_from + s * (b_to - b_from)));
+void GyroAccumulator::step(const Eigen::Vector3d& raw, double s, double dt) {
+  const Eigen::Vector3d rate = rateOf(raw, s);
+  Eigen::Matrix3d step_R, step_Jr;
+  expAndRightJacobian(rate * dt, &step_R, &step_Jr);
+  // d rate / d T_g(r, c) = -T_g^-1 e_r rate_c; d rate / d b = -(1 - s or s) T_g^-1.
+  const Eigen::Matrix3d M = -dt * step_Jr * T_g_inverse;
+  J = step_R.transpose() * J;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) J.col(3 * r + c) += M.col(r) * rate(c);
   }
+  J.block<3, 3>(0, 9) += (1.0 - s) * M;
+  J.block<3, 3>(0, 12) += s * M;
+  delta_R = delta_R * step_R;
+  duration_s += dt;
+}
 
-  void step(const Eigen::Vector3d& raw, double s, double dt) {
-    const Eigen::Vector3d rate = rateOf(raw, s);
-    Eigen::Matrix3d step_R, step_Jr;
-    expAndRightJacobian(rate * dt, &step_R, &step_Jr);
-    // d rate / d T_g(r, c) = -T_g^-1 e_r rate_c; d rate / d b = -(1 - s or s) T_g^-1.
-    const Eigen::Matrix3d M = -dt * step_Jr * T_g_inverse;
-    J = step_R.transpose() * J;
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) J.col(3 * r + c) += M.col(r) * rate(c);
-    }
-    J.block<3, 3>(0, 9) += (1.0 - s) * M;
-    J.block<3, 3>(0, 12) += s * M;
-    delta_R = delta_R * step_R;
-    duration_s += dt;
-  }
-
-  GyroPreintegration result(const GyroModelVector& theta0) const {
-    GyroPreintegration out;
-    out.theta0 = theta0;
-    out.delta_R = projectToSO3(delta_R);
-    out.jacobian = J;
-    out.duration_s = duration_s;
-    return out;
-  }
-};
-
-}  // namespace
+GyroPreintegration GyroAccumulator::result(const GyroModelVector& theta0) const {
+  GyroPreintegration out;
+  out.theta0 = theta0;
+  out.delta_R = projectToSO3(delta_R);
+  out.jacobian = J;
+  out.duration_s = duration_s;
+  return out;
+}
 
 GyroPreintegration preintegrateGyro(const std::vector<double>& stamps_s,
                                     const std::vector<Eigen::Vector3d>& gyro_rad_s, double t_from_s,
                                     double t_to_s, const Eigen::Matrix3d& T_g,
                                     const Eigen::Vector3d& b_from, const Eigen::Vector3d& b_to) {
-  Accumulator acc{T_g.inverse(), b_from, b_to};
+  GyroAccumulator acc{T_g.inverse(), b_from, b_to};
   const std::vector<double> dt = sampleIntervals(stamps_s);
   const double ramp_s = t_to_s - t_from_s;
   const size_t n = std::min(stamps_s.size(), gyro_rad_s.size());
@@ -133,7 +118,7 @@ GyroPreintegration preintegrateGyroInterval(
     const std::vector<double>& stamps_s, const std::vector<Eigen::Vector3d>& gyro_rad_s,
     double t_from_s, double t_to_s, const Eigen::Matrix3d& T_g, const Eigen::Vector3d& b_from,
     const Eigen::Vector3d& b_to, Eigen::Vector3d* rate_from, Eigen::Vector3d* rate_to) {
-  Accumulator acc{T_g.inverse(), b_from, b_to};
+  GyroAccumulator acc{T_g.inverse(), b_from, b_to};
   const GyroModelVector theta0 = gyroModelVector(T_g, b_from, b_to);
   const size_t n = std::min(stamps_s.size(), gyro_rad_s.size());
   const double ramp_s = t_to_s - t_from_s;

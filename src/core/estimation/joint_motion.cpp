@@ -10,6 +10,7 @@
 
 #include "camera_imu_alignment/estimation/gyro_preintegration.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
+#include "gyro_accumulator.h"
 
 namespace camera_imu_alignment {
 namespace joint {
@@ -328,32 +329,13 @@ AccelLinkIntegral integrateAccelLink(const GyroStream& samples, double t_from_s,
   const size_t n = std::min({stamps.size(), samples.gyro_rad_s.size(), samples.accel_m_s2.size()});
   const double span = t_to_s - t_from_s;
   if (n < 2 || !(span > 0.0)) return out;
-  const Eigen::Matrix3d T_g_inverse = T_g.inverse();
   const auto interpolate = [&](const std::vector<Eigen::Vector3d>& values, double t) {
     return interpolateSamples(stamps, values, n, t);
   };
-  // The calibrated rate at t and its derivative with respect to theta (T_g row-major, b_from,
-  // b_to): d(T_g^-1 u)/dT_g(i, j) = -T_g^-1 e_i omega_j.
-  Eigen::Matrix<double, 3, 15> rate_jacobian;
-  const auto rateAt = [&](double t) {
-    const double s = std::clamp((t - t_from_s) / span, 0.0, 1.0);
-    const Eigen::Vector3d omega =
-        T_g_inverse * (interpolate(samples.gyro_rad_s, t) - (b_from + s * (b_to - b_from)));
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) rate_jacobian.col(3 * i + j) = -T_g_inverse.col(i) * omega(j);
-    }
-    rate_jacobian.middleCols<3>(9) = -(1.0 - s) * T_g_inverse;
-    rate_jacobian.rightCols<3>() = -s * T_g_inverse;
-    return omega;
-  };
-  // Right Jacobian of SO(3) to second order (steps of a few milliradians).
-  const auto rightJacobian = [](const Eigen::Vector3d& phi) {
-    const Eigen::Matrix3d K = skew(phi);
-    return Eigen::Matrix3d(Eigen::Matrix3d::Identity() - 0.5 * K + K * K / 6.0);
-  };
-  Eigen::Matrix3d delta_R = Eigen::Matrix3d::Identity();
-  // d DeltaR / d theta as a right perturbation: DeltaR(theta + d) = DeltaR Exp(phi d).
-  Eigen::Matrix<double, 3, 15> phi = Eigen::Matrix<double, 3, 15>::Zero();
+  // The rotation and its derivative, as the gyro's preintegration takes them; each sub-interval
+  // between samples is integrated at its midpoint, where the accelerometer is turned by the
+  // rotation half-way through it.
+  GyroAccumulator rotation{T_g.inverse(), b_from, b_to};
   double t = t_from_s;
   size_t i = static_cast<size_t>(std::upper_bound(stamps.begin(), stamps.begin() + n, t_from_s) -
                                  stamps.begin());
@@ -361,39 +343,33 @@ AccelLinkIntegral integrateAccelLink(const GyroStream& samples, double t_from_s,
     const double next = i < n ? std::min(stamps[i], t_to_s) : t_to_s;
     if (next > t) {
       const double dt = next - t, mid = 0.5 * (t + next);
+      const double s = std::clamp((mid - t_from_s) / span, 0.0, 1.0);
+      const Eigen::Vector3d raw = interpolate(samples.gyro_rad_s, mid);
+      GyroAccumulator half = rotation;
+      half.step(raw, s, 0.5 * dt);
+      const Eigen::Matrix3d& R_mid = half.delta_R;
+      const Eigen::Vector3d a = interpolate(samples.accel_m_s2, mid);
+      // d(R_mid a) = -R_mid [a]x J_mid d.
+      const Eigen::Matrix<double, 3, 15> turned = -R_mid * skew(a) * half.J;
       // Velocity: weight 1; position: the double integral, weight (to - t).
       const double w[2] = {1.0, t_to_s - mid};
-      const Eigen::Vector3d rate = rateAt(mid);
-      const Eigen::Vector3d half = 0.5 * dt * rate;
-      const Eigen::Matrix3d E_half = expSO3(half);
-      const Eigen::Matrix3d R_mid = delta_R * E_half;
-      const Eigen::Matrix<double, 3, 15> phi_mid =
-          E_half.transpose() * phi + rightJacobian(half) * (0.5 * dt) * rate_jacobian;
-      const Eigen::Vector3d a = interpolate(samples.accel_m_s2, mid);
-      // d(R_mid a) = -R_mid [a]x phi_mid d.
-      const Eigen::Matrix<double, 3, 15> turned = -R_mid * skew(a) * phi_mid;
       for (int k = 0; k < 2; ++k) {
         out.d0[k] += w[k] * dt * R_mid * a;
         out.bias_jacobian[k] += w[k] * dt * R_mid;
         out.gyro_jacobian[k] += w[k] * dt * turned;
-        for (int s = 0; s < 3; ++s) {
+        for (int r = 0; r < 3; ++r) {
           for (int u = 0; u < 3; ++u) {
-            out.per_entry[k].col(3 * s + u) += w[k] * dt * R_mid.col(s) * a(u);
+            out.per_entry[k].col(3 * r + u) += w[k] * dt * R_mid.col(r) * a(u);
           }
         }
       }
-      const Eigen::Vector3d step = dt * rate;
-      const Eigen::Matrix3d E = expSO3(step);
-      phi = E.transpose() * phi + rightJacobian(step) * dt * rate_jacobian;
-      delta_R = delta_R * E;
+      rotation.step(raw, s, dt);
     }
     t = next;
     ++i;
   }
   out.duration_s = span;
-  for (int k = 0; k < 9; ++k) out.theta0_minus_identity(k) = T_g(k / 3, k % 3) - (k % 4 == 0);
-  out.theta0_minus_identity.segment<3>(9) = b_from;
-  out.theta0_minus_identity.segment<3>(12) = b_to;
+  out.theta0_minus_identity = gyroModelVector(T_g - Eigen::Matrix3d::Identity(), b_from, b_to);
   return out;
 }
 

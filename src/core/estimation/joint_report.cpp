@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <unordered_set>
 #include <utility>
 
 #include "camera_imu_alignment/solver/rotation_math.h"
@@ -122,22 +123,17 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
   // Covariance of R_cam_imu and of every estimated block.
   std::map<const double*, int> requested;
   std::vector<std::pair<const double*, const double*>> pairs;
+  // Not reported, and many: the mount deltas, the motion nodes' gyro biases, the acceleration
+  // model's keyframe states and link biases.
+  std::unordered_set<const double*> unreported = {state.e_T.data()};
+  for (const auto& d : state.delta) unreported.insert(d.data());
+  for (size_t k = 0; k < n; ++k) {
+    if (!problem.poses[k].at_rest) unreported.insert(state.gyro_bias[k].data());
+  }
+  for (const auto& pv : state.keyframe_pv) unreported.insert(pv.data());
+  for (const auto& b : state.link_accel_bias) unreported.insert(b.data());
   for (double* block : built.free_blocks) {
-    if (block == state.e_T.data()) continue;
-    bool is_delta = false;
-    for (const auto& d : state.delta) is_delta = is_delta || block == d.data();
-    if (is_delta) continue;
-    bool is_node_bias = false;  // motion nodes' gyro biases: many, and not reported
-    for (size_t k = 0; k < n; ++k) {
-      is_node_bias =
-          is_node_bias || (!problem.poses[k].at_rest && block == state.gyro_bias[k].data());
-    }
-    if (is_node_bias) continue;
-    // The acceleration model's keyframe states and link biases: many, and not reported.
-    bool is_link_state = false;
-    for (const auto& pv : state.keyframe_pv) is_link_state = is_link_state || block == pv.data();
-    for (const auto& b : state.link_accel_bias) is_link_state = is_link_state || block == b.data();
-    if (is_link_state) continue;
+    if (unreported.count(block) > 0) continue;
     requested[block] = ceres_problem->ParameterBlockSize(block);
     pairs.emplace_back(block, block);
   }
