@@ -78,6 +78,45 @@ TEST(MotionCalibrator, CalibratesARecordingWithoutRestsAndFindsTheTimeOffset) {
   }
 }
 
+TEST(MotionCalibrator, ABagsMotionIsSolvedAsTheWindowDoublesWithTheSameFinalEstimate) {
+  // calibrate_bag's cadence (motion_solves_double): a solve when the window has doubled since the
+  // last, and one at finish() for the motion after it; the nodelet's: every 100 frames. The final
+  // window is the same, so is its estimate; calibrateNow after finish() with nothing new is that
+  // solve itself (the same solve time), not another.
+  test::MotionSimulationOptions options;
+  options.gyro_scale = 0.0;
+  options.gyro_cross_axis = 0.0;
+  const test::MotionSimulation sim = test::simulateMotionProblem(options, 24);
+  const size_t frames = sim.problem.motion_frames.size();
+  ASSERT_GE(frames, 1000u);
+  std::vector<CalibrateOutcome> outcomes;
+  std::vector<size_t> solves;
+  for (bool doubling : {false, true}) {
+    std::vector<EstimateEvent> estimates;
+    OnlineCallbacks callbacks;
+    callbacks.on_estimate = [&](const EstimateEvent& e) { estimates.push_back(e); };
+    OnlineSettings online;
+    online.threaded = false;
+    online.motion_solves_double = doubling;
+    OnlineCalibrator calibrator(test::simulatedTarget(simulation::SimulationConfig{}),
+                                PipelineSettings{}, online, callbacks);
+    feed(sim, &calibrator);
+    ASSERT_FALSE(estimates.empty());
+    const JointResult last = *estimates.back().result.joint;
+    solves.push_back(estimates.size());
+    outcomes.push_back(calibrator.calibrateNow(false));
+    ASSERT_TRUE(outcomes.back().result.joint && outcomes.back().result.joint->ok);
+    EXPECT_EQ(outcomes.back().result.joint->solve_time_s, last.solve_time_s) << "re-solved";
+  }
+  // 100 frames per solve, and the motion after the last at finish().
+  EXPECT_EQ(solves[0], (frames + 99) / 100);
+  // Windows of 100, 200, 400, 800 frames, then all of them at finish().
+  size_t doublings = 1;
+  for (size_t window = 100; 2 * window < frames; window *= 2) ++doublings;
+  EXPECT_EQ(solves[1], doublings + 1);
+  EXPECT_LT(geodesicDistance(outcomes[0].result.R_cam_imu, outcomes[1].result.R_cam_imu), 1e-9);
+}
+
 TEST(MotionCalibrator, AnOffsetBeyondTheSearchRangeIsNamedWithTheRange) {
   test::MotionSimulationOptions options;
   options.timeshift_cam_imu_s = 0.3;

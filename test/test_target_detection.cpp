@@ -351,6 +351,35 @@ TEST(RenderedTargets, SymmetricBoardFollowsTheHintThroughAHalfTurn) {
   }
 }
 
+TEST(RenderedTargets, SearchingNearARecentDetectionFindsTheSameCorners) {
+  // The corners of one view as the recent detection of the next (the camera turned a little):
+  // the search box around them finds the board with the same refined corners as the whole
+  // image; points far from the board (another view's, moved off to a corner) and a box that
+  // covers nothing still find it, through the whole image.
+  const SimulationConfig c = scenario("nominal");
+  const TargetDetector detector(descriptionOf(c));
+  const auto views = renderHolds(c, 4);
+  for (size_t k = 0; k < views.size(); ++k) {
+    TargetObservation whole, near, far, degenerate;
+    ASSERT_TRUE(detector.detect(views[k].image, &whole));
+    TargetObservation previous;
+    ASSERT_TRUE(detector.detect(views[k == 0 ? 0 : k - 1].image, &previous));
+    std::vector<cv::Point2f> moved = whole.image_points;
+    for (cv::Point2f& p : moved) p = cv::Point2f(5.0f + 0.05f * p.x, 5.0f + 0.05f * p.y);
+    const std::vector<cv::Point2f> one_point = {whole.image_points.front()};
+    ASSERT_TRUE(detector.detect(views[k].image, &near, nullptr, &whole.image_points));
+    ASSERT_TRUE(detector.detect(views[k].image, &far, nullptr, &moved));
+    ASSERT_TRUE(detector.detect(views[k].image, &degenerate, nullptr, &one_point));
+    for (const TargetObservation* o : {&near, &far, &degenerate}) {
+      ASSERT_EQ(o->image_points.size(), whole.image_points.size());
+      EXPECT_EQ(o->point_ids, whole.point_ids);
+      for (size_t i = 0; i < whole.image_points.size(); ++i) {
+        EXPECT_LT(cv::norm(o->image_points[i] - whole.image_points[i]), 1e-3) << "view " << k;
+      }
+    }
+  }
+}
+
 TEST(RenderedTargets, NoTargetAndGarbageImagesAreNotDetections) {
   const SimulationConfig c = scenario("nominal");
   const TargetDetector detector(descriptionOf(c));

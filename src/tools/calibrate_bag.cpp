@@ -16,6 +16,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "bag_reader.h"
@@ -221,6 +222,11 @@ int run(const cia::CliArgs& args) {
     reject_log(r, stream, d);
   };
   online.threaded = false;
+  // Faster than real time: a growing window of motion is solved as it doubles, each solve on up
+  // to two cores.
+  online.motion_solves_double = true;
+  settings.joint.solver_threads =
+      static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 2u));
   std::unique_ptr<cia::OnlineCalibrator> calibrator;
   try {
     calibrator = std::make_unique<cia::OnlineCalibrator>(target, settings, online, callbacks);

@@ -215,6 +215,10 @@ struct JointSettings {
   double robust_loss_scale = 4.0;
   int max_iterations = 50;       ///< Levenberg-Marquardt iterations per solve
   int max_relinearisations = 5;  ///< gyro preintegration passes (outer loop), >= 2
+  /// Ceres threads per solve (residual and Jacobian evaluation; the same estimate with any
+  /// count). 1 in the nodelet, which leaves the other core to its callbacks; calibrate_bag uses
+  /// the machine's cores (up to 2). Not a setting key.
+  int solver_threads = 1;
   MagnetometerUse use_magnetometer = MagnetometerUse::kAuto;
   /// Local gravity (m/s^2) of the accelerometer model. The pipeline sets it from the setting
   /// gravity_m_s2 (jointSettingsOf in calibration_pipeline.h), as the stationary detector's.

@@ -81,7 +81,8 @@ class OnlineCalibrator : public SampleSink {
   void addFrame(const CameraFrame& frame) override;
   void rejectInput(RejectReason reason, InputStream stream, const std::string& detail) override;
   ImuOrientationSource imuOrientationSource() const override;
-  /// End of data (or the IMU stopped): closes the rest in progress.
+  /// End of data (or the IMU stopped): closes the rest in progress, and solves the window when
+  /// camera frames during motion arrived since its last solve.
   void finish();
   /// Applies finished solves (threaded); call periodically.
   void poll();

@@ -46,6 +46,12 @@ struct OnlineSettings {
   double remount_residual_deg = 1.5;
   /// Solve on a worker thread (the nodelet); false: on the caller's thread (calibrate_bag, tests).
   bool threaded = true;
+  /// Continuous motion: a window is solved after every 100 new camera frames during motion (5 s
+  /// at 20 Hz; the nodelet, whose worker skips windows when it is busy). True (calibrate_bag, which
+  /// reads faster than real time): after as many new frames as the window had at its last solve
+  /// (and at least 100), so that the solves of a growing window cost about twice its last one, not
+  /// in proportion to its square. Set by the tool, not a parameter.
+  bool motion_solves_double = false;
   /// "" when usable, else the first unusable setting named by its key.
   std::string validate() const;
 };

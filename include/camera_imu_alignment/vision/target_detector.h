@@ -41,9 +41,16 @@ class TargetDetector {
   explicit TargetDetector(const TargetDescription& target, const DetectorSettings& settings = {});
   ~TargetDetector();
   /// Detects the target in `mono8` (CV_8UC1). Returns false when not found. `R_target_cam_hint`
-  /// (optional) is a recent camera orientation used to resolve symmetric boards.
+  /// (optional) is a recent camera orientation used to resolve symmetric boards. `near_points`
+  /// (optional; pixels) are the target's image points in a recent frame: a checkerboard is looked
+  /// for first in the box around them, grown by kSearchBoxMargin of their extent on each side,
+  /// then (not found there) in the whole image. The corners are refined in the whole image either
+  /// way: only the cost differs (the classic detector's search grows with the pixels searched).
   bool detect(const cv::Mat& mono8, TargetObservation* observation,
-              const Eigen::Matrix3d* R_target_cam_hint = nullptr) const;
+              const Eigen::Matrix3d* R_target_cam_hint = nullptr,
+              const std::vector<cv::Point2f>* near_points = nullptr) const;
+  /// The margin of the search box around `near_points` (fraction of their extent per side).
+  static constexpr double kSearchBoxMargin = 0.15;
   const TargetDescription& target() const { return target_; }
   /// Rotations S of the target frame (about its z axis, through the board centre; identity
   /// excluded) under which this detector cannot tell the board from itself: the camera

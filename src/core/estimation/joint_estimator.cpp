@@ -66,7 +66,7 @@ ceres::Solver::Options solverOptions(const JointSettings& settings) {
   options.function_tolerance = 1e-10;
   options.gradient_tolerance = 1e-12;
   options.parameter_tolerance = 1e-10;
-  options.num_threads = 1;
+  options.num_threads = std::max(1, settings.solver_threads);
   options.logging_type = ceres::SILENT;
   return options;
 }

@@ -46,6 +46,13 @@ struct OnlineCalibrator::Impl {
   CalibrationState state = CalibrationState::kWaitingForData;
   std::string message = "waiting for IMU and camera data";
   std::optional<EstimateEvent> last_estimate;
+  /// The newest solve applied as an estimate (no remount, not stale), for calibrateNow.
+  std::optional<SolveOutput> last_solved;
+  std::uint64_t finishes = 0;  ///< finish() calls (each may close a rest)
+  InputMark inputMark() const {
+    return {generation, pipeline->imuSamples(), pipeline->magneticSamples(), pipeline->frames(),
+            finishes};
+  }
   std::optional<BroadcastEstimate> broadcast;
   std::optional<StationaryPose> last_pose;
   bool fresh_start = false;    ///< the broadcast estimate is no reference (remount, reset)
@@ -79,6 +86,8 @@ struct OnlineCalibrator::Impl {
   /// Continuous motion: a solve after kMotionFramesPerSolve motion frames without one.
   void onMotionFrames();
   std::uint64_t motion_frames_solved = 0;  ///< pipeline->motionFrames() at the last such solve
+  /// Motion frames in the window of the last solve (OnlineSettings::motion_solves_double).
+  std::uint64_t motion_frames_in_solved_window = 0;
   /// StationaryPose::index of the newest pose a change-point test had in its window (-1: none
   /// since the poses were last cleared).
   int newest_pose_change_tested = -1;
@@ -188,7 +197,9 @@ void OnlineCalibrator::Impl::requestSolve() {
   motion_frames_solved = pipeline->motionFrames();
   SolveJob job;
   job.generation = generation;
+  job.inputs = inputMark();
   job.window = pipeline->snapshot();
+  motion_frames_in_solved_window = job.window.joint.motion_frames.size();
   job.test_mount_change = joint();
   job.poses_not_yet_tested = static_cast<int>(
       std::count_if(job.window.pose_indices.begin(), job.window.pose_indices.end(),
@@ -203,7 +214,10 @@ void OnlineCalibrator::Impl::requestSolve() {
 void OnlineCalibrator::Impl::onMotionFrames() {
   constexpr std::uint64_t kMotionFramesPerSolve = 100;  // 5 s at 20 Hz
   const std::uint64_t frames = pipeline->motionFrames();
-  if (frames < motion_frames_solved + kMotionFramesPerSolve) return;
+  const std::uint64_t wait = settings.motion_solves_double
+                                 ? std::max(kMotionFramesPerSolve, motion_frames_in_solved_window)
+                                 : kMotionFramesPerSolve;
+  if (frames < motion_frames_solved + wait) return;
   requestSolve();
 }
 
@@ -225,6 +239,8 @@ void OnlineCalibrator::Impl::apply(SolveOutput output) {
     applyRemount(output);
     return;
   }
+  last_solved = output;
+  last_solved->mount_test.reset();
   applyEstimate(judged(std::move(output)));
 }
 
@@ -267,6 +283,7 @@ void OnlineCalibrator::Impl::applyRemount(const SolveOutput& output) {
     const int first = kept.empty() ? next_index : kept.front().index;
     restartWindowAt(first, first, test.change_deg, text);
     motion_frames_solved = pipeline->motionFrames();  // the next solve waits for new motion
+    motion_frames_in_solved_window = 0;
     return;
   }
   const int first_index = output.window.pose_indices.at(test.first_pose_after);
@@ -389,6 +406,10 @@ ImuOrientationSource OnlineCalibrator::imuOrientationSource() const {
 
 void OnlineCalibrator::finish() {
   impl_->pipeline->finish();
+  ++impl_->finishes;
+  // Motion since the last solve: its window is solved now, so that the change-point test also
+  // sees the end of the recording.
+  if (impl_->pipeline->motionFrames() > impl_->motion_frames_solved) impl_->requestSolve();
   impl_->poll();
 }
 
@@ -401,11 +422,17 @@ void OnlineCalibrator::waitForSolves() {
 
 CalibrateOutcome OnlineCalibrator::calibrateNow(bool force) {
   waitForSolves();
-  SolveJob job;
-  job.generation = impl_->generation;
-  job.window = impl_->pipeline->snapshot();
-  const std::size_t poses = job.window.pose_indices.size();
-  SolveOutput output = runSolveJob(std::move(job), impl_->pipeline_settings, impl_->settings);
+  SolveOutput output;
+  if (impl_->last_solved && impl_->last_solved->inputs == impl_->inputMark()) {
+    output = *impl_->last_solved;  // nothing came in since: the same window, solved
+  } else {
+    SolveJob job;
+    job.generation = impl_->generation;
+    job.inputs = impl_->inputMark();
+    job.window = impl_->pipeline->snapshot();
+    output = runSolveJob(std::move(job), impl_->pipeline_settings, impl_->settings);
+  }
+  const std::size_t poses = output.window.pose_indices.size();
   CalibrateOutcome out;
   out.window_poses = poses;
   out.result = output.result;
@@ -446,6 +473,7 @@ void OnlineCalibrator::reset() {
   impl_->newest_pose_change_tested = -1;
   ++impl_->generation;
   impl_->last_estimate.reset();
+  impl_->last_solved.reset();
   impl_->last_pose.reset();
   impl_->inconsistent_poses = 0;
   impl_->remounts = 0;

@@ -10,6 +10,7 @@ SolveOutput runSolveJob(SolveJob job, const PipelineSettings& pipeline,
                         const OnlineSettings& online) {
   SolveOutput out;
   out.generation = job.generation;
+  out.inputs = job.inputs;
   out.result = solveWindow(job.window, pipeline);
   if (job.test_mount_change && out.result.joint && out.result.joint->ok) {
     // A split whose first pose was never a candidate of a test (its windows were skipped) is

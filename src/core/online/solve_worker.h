@@ -15,8 +15,20 @@
 
 namespace camera_imu_alignment {
 
+/// What the calibrator had taken in when a window was taken: a later window taken with the same
+/// mark holds the same data (OnlineCalibrator::calibrateNow then reuses its solve).
+struct InputMark {
+  std::uint64_t generation = 0;  ///< bumped by reset, remount, clock jump
+  std::uint64_t imu = 0, magnetic = 0, frames = 0, finishes = 0;
+  bool operator==(const InputMark& o) const {
+    return generation == o.generation && imu == o.imu && magnetic == o.magnetic &&
+           frames == o.frames && finishes == o.finishes;
+  }
+};
+
 struct SolveJob {
   std::uint64_t generation = 0;  ///< the window's generation when taken (reset, remount, jump)
+  InputMark inputs;              ///< when the window was taken
   WindowSnapshot window;
   bool test_mount_change = false;
   /// The window's newest poses that no earlier change-point test had among its poses (the
@@ -27,6 +39,7 @@ struct SolveJob {
 
 struct SolveOutput {
   std::uint64_t generation = 0;
+  InputMark inputs;       ///< the job's
   WindowSnapshot window;  ///< the job's (pose indices of the estimate)
   AlignmentResult result;
   std::optional<MountChangeTest> mount_test;

@@ -117,6 +117,10 @@ struct CalibrationPipeline::Impl {
   double last_motion_frame_stamp = -std::numeric_limits<double>::infinity();
   std::uint64_t motion_frames_total = 0;
   std::uint64_t motion_detections = 0;  ///< frames during motion on which detection ran
+  /// The target's image points (pixels) in the last frame during motion where it was found, and
+  /// that frame's stamp (s): the next frame's detection searches near them first.
+  std::vector<cv::Point2f> last_motion_points;
+  double last_motion_points_stamp = -std::numeric_limits<double>::infinity();
 
   // --- natural scene (no target: TargetDescription::numPoints() == 0; scene_assembly.cpp)
   bool natural_scene = false;

@@ -217,13 +217,36 @@ std::string cornerCountText(int a, int b) {
   return std::to_string(std::max(a, b)) + " x " + std::to_string(std::min(a, b));
 }
 
+/// The box around `points` grown by `margin` of their extent on each side, within the image.
+cv::Rect searchBox(const std::vector<cv::Point2f>& points, double margin, const cv::Size& image) {
+  const cv::Rect box = cv::boundingRect(points);
+  const int grow_x = static_cast<int>(std::ceil(margin * box.width));
+  const int grow_y = static_cast<int>(std::ceil(margin * box.height));
+  const cv::Rect grown(box.x - grow_x, box.y - grow_y, box.width + 2 * grow_x,
+                       box.height + 2 * grow_y);
+  return grown & cv::Rect(0, 0, image.width, image.height);
+}
+
 bool detectCheckerboard(const cv::Mat& mono8, const TargetDescription& t, bool subpixel,
+                        const std::vector<cv::Point2f>* near_points,
                         std::vector<cv::Point2f>* corners, std::string* mismatch) {
   const cv::Size size(t.cols, t.rows);
+  constexpr int kClassicFlags = cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK;
+  // 0. Near a recent detection first (a camera in motion: 1.9 -> 0.8 ms per 640x480 frame of
+  //    the waving simulation, the same refined corners).
+  bool found = false;
+  if (near_points && near_points->size() >= 2) {
+    const cv::Rect box = searchBox(*near_points, TargetDetector::kSearchBoxMargin, mono8.size());
+    if (box.area() > 0 && box.area() < mono8.size().area()) {
+      found = cv::findChessboardCorners(mono8(box), size, *corners, kClassicFlags);
+      if (found) {
+        for (cv::Point2f& c : *corners) c += cv::Point2f(box.tl());
+      }
+    }
+  }
   // 1. The classic detector without its adaptive-threshold search, after the fast rejection of
   //    frames without a board: a few ms when the board is plainly in view.
-  bool found = cv::findChessboardCorners(mono8, size, *corners,
-                                         cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK);
+  if (!found) found = cv::findChessboardCorners(mono8, size, *corners, kClassicFlags);
   // 2. The sector-based detector (blur, strong perspective, uneven light), allowed to find a
   //    board larger than the file's. The classic detector's adaptive search is not used: on a
   //    board of another size than the file's it took 3-4 s per frame to fail (measured on a
@@ -273,7 +296,8 @@ bool detectCircleGrid(const cv::Mat& mono8, const TargetDescription& t,
 }  // namespace
 
 bool TargetDetector::detect(const cv::Mat& mono8, TargetObservation* observation,
-                            const Eigen::Matrix3d* R_target_cam_hint) const {
+                            const Eigen::Matrix3d* R_target_cam_hint,
+                            const std::vector<cv::Point2f>* near_points) const {
   if (!observation || mono8.empty() || mono8.type() != CV_8UC1) return false;
   observation->image_points.clear();
   observation->point_ids.clear();
@@ -281,7 +305,7 @@ bool TargetDetector::detect(const cv::Mat& mono8, TargetObservation* observation
   switch (target_.type) {
     case TargetDescription::Type::kCheckerboard: {
       std::vector<cv::Point2f> corners;
-      if (!detectCheckerboard(mono8, target_, settings_.subpixel, &corners,
+      if (!detectCheckerboard(mono8, target_, settings_.subpixel, near_points, &corners,
                               &observation->mismatch)) {
         return false;
       }
