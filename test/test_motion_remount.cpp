@@ -1,16 +1,17 @@
 // A mount change during continuous motion (issue 25: "remount detection works on motion too"):
 // the waving scenario (60 s, no rests, consumer unit, 15 ms camera offset, camera orientations at
 // 20 Hz as camera_pose gives them) with R_cam_imu turned by 3 deg about a camera axis over 1 s at
-// 30 s, fed to the online calibrator unthreaded as calibrate_bag feeds it. Against the simulated
-// truth: the change is declared once, located within 1 s of where it happened, and the estimate
-// after it (from the motion after the change alone) is within 3 of its 1-sigma of the new mount;
-// the same recordings without a change declare none.
+// 30 s, fed to the online calibrator as calibrate_bag feeds it (solveAsRecording). Against the
+// simulated truth: the change is declared once, located within 1 s of where it happened, and the
+// estimate after it (from the motion after the change alone) is within 3 of its 1-sigma of the new
+// mount; the same recordings without a change declare none.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <vector>
 
+#include "camera_imu_alignment/config/online_config.h"
 #include "camera_imu_alignment/estimation/mount_change.h"
 #include "camera_imu_alignment/online/online_calibrator.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
@@ -34,9 +35,9 @@ Outcome calibrate(const simulation::SimulationConfig& c, const simulation::Simul
   OnlineCallbacks callbacks;
   callbacks.on_remount = [&](const RemountEvent& e) { out.remounts.push_back(e); };
   OnlineSettings online;
-  online.threaded = false;
   PipelineSettings settings;
   settings.joint = test::jointSettingsFor(c);
+  solveAsRecording(&settings, &online);
   OnlineCalibrator calibrator(test::simulatedTarget(c), settings, online, callbacks);
   test::feedOrientations(run, &calibrator);
   calibrator.finish();

@@ -16,7 +16,6 @@
 #include <iostream>
 #include <memory>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "bag_reader.h"
@@ -221,12 +220,7 @@ int run(const cia::CliArgs& args) {
   callbacks.on_reject = [&](cia::RejectReason r, cia::InputStream stream, const std::string& d) {
     reject_log(r, stream, d);
   };
-  online.threaded = false;
-  // Faster than real time: a growing window of motion is solved as it doubles, each solve on up
-  // to two cores.
-  online.motion_solves_double = true;
-  settings.joint.solver_threads =
-      static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 2u));
+  cia::solveAsRecording(&settings, &online);  // faster than real time, the same verdicts
   std::unique_ptr<cia::OnlineCalibrator> calibrator;
   try {
     calibrator = std::make_unique<cia::OnlineCalibrator>(target, settings, online, callbacks);

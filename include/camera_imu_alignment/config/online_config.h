@@ -41,4 +41,10 @@ void parseCalibrationConfig(
     const std::function<bool(const std::string&, const YAML::Node&)>& handled = {},
     const std::vector<std::string>& other_keys = {});
 
+/// How calibrate_bag solves a recording faster than real time, with the estimates and verdicts of
+/// solving each window on the caller's thread: on the worker with solves_in_order, motion solved
+/// as its window doubles (motion_solves_double), the joint estimate on up to two cores
+/// (JointSettings::solver_threads). The other settings (the user's config) are left as they are.
+void solveAsRecording(PipelineSettings* pipeline, OnlineSettings* online);
+
 }  // namespace camera_imu_alignment

@@ -44,8 +44,14 @@ struct OnlineSettings {
   /// estimate by more than remount_residual_deg (RMS) restart the window from them.
   int remount_poses = 3;
   double remount_residual_deg = 1.5;
-  /// Solve on a worker thread (the nodelet); false: on the caller's thread (calibrate_bag, tests).
+  /// Solve on a worker thread (the nodelet); false: on the caller's thread (tests).
   bool threaded = true;
+  /// With threaded (calibrate_bag): every window requested is solved, none skipped, while the
+  /// input goes on, and its result is applied when the next solve is requested (or at finish(),
+  /// waitForSolves(), calibrateNow()), not whenever it finishes: the results and verdicts do not
+  /// depend on the threads' timing. False (the nodelet): the newest window waiting replaces older
+  /// ones and results are applied as they finish.
+  bool solves_in_order = false;
   /// Continuous motion: a window is solved after every 100 new camera frames during motion (5 s
   /// at 20 Hz; the nodelet, whose worker skips windows when it is busy). True (calibrate_bag, which
   /// reads faster than real time): after as many new frames as the window had at its last solve

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "camera_imu_alignment/config/pipeline_config.h"
 #include "camera_imu_alignment/config/settings_checks.h"
@@ -117,6 +118,14 @@ void loadCalibrationConfig(const std::string& path, PipelineSettings* pipeline,
         return std::find(ignored_keys.begin(), ignored_keys.end(), name) != ignored_keys.end();
       },
       ignored_keys);
+}
+
+void solveAsRecording(PipelineSettings* pipeline, OnlineSettings* online) {
+  online->threaded = true;
+  online->solves_in_order = true;
+  online->motion_solves_double = true;
+  pipeline->joint.solver_threads =
+      static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 2u));
 }
 
 }  // namespace camera_imu_alignment

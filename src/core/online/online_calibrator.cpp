@@ -91,7 +91,10 @@ struct OnlineCalibrator::Impl {
   /// StationaryPose::index of the newest pose a change-point test had in its window (-1: none
   /// since the poses were last cleared).
   int newest_pose_change_tested = -1;
+  /// Applies what the worker finished (threaded, not solves_in_order); call periodically.
   void poll();
+  /// Waits for the worker's solve, if any, and applies it (every mode).
+  void applyFinished();
   void apply(SolveOutput output);
   void applyRemount(const SolveOutput& output);
   /// Keeps the window's poses from `kept_index` on (the mount changed before `first_index` <=
@@ -194,6 +197,7 @@ void OnlineCalibrator::Impl::restartWindowAt(int first_index, int kept_index, do
 }
 
 void OnlineCalibrator::Impl::requestSolve() {
+  if (worker && settings.solves_in_order) applyFinished();  // the previous solve's, first
   motion_frames_solved = pipeline->motionFrames();
   SolveJob job;
   job.generation = generation;
@@ -222,7 +226,13 @@ void OnlineCalibrator::Impl::onMotionFrames() {
 }
 
 void OnlineCalibrator::Impl::poll() {
+  if (!worker || settings.solves_in_order) return;  // in order: applied at the defined points
+  for (SolveOutput& output : worker->takeFinished()) apply(std::move(output));
+}
+
+void OnlineCalibrator::Impl::applyFinished() {
   if (!worker) return;
+  worker->waitIdle();
   for (SolveOutput& output : worker->takeFinished()) apply(std::move(output));
 }
 
@@ -415,10 +425,7 @@ void OnlineCalibrator::finish() {
 
 void OnlineCalibrator::poll() { impl_->poll(); }
 
-void OnlineCalibrator::waitForSolves() {
-  if (impl_->worker) impl_->worker->waitIdle();
-  impl_->poll();
-}
+void OnlineCalibrator::waitForSolves() { impl_->applyFinished(); }
 
 CalibrateOutcome OnlineCalibrator::calibrateNow(bool force) {
   waitForSolves();
@@ -466,8 +473,7 @@ CalibrateOutcome OnlineCalibrator::calibrateNow(bool force) {
 }
 
 void OnlineCalibrator::reset() {
-  if (impl_->worker) impl_->worker->waitIdle();
-  impl_->poll();
+  impl_->applyFinished();
   impl_->pipeline->reset();
   impl_->motion_frames_solved = 0;
   impl_->newest_pose_change_tested = -1;
