@@ -190,6 +190,15 @@ TEST(CalibrationSnapshot, ASavedEstimateIsTheBestThatPassedWhileTheTfStays) {
 // The rotation to make next, in a driver's words (issue 26: the status tells how to drive): the
 // axis against the vertical in the camera frame, on constructed axes at 0, 45 and 90 deg from it,
 // whichever way the camera looks.
+TEST(CalibrationSnapshot, ARemountIsPlacedByItsPoseOrItsTimeDuringTheMotion) {
+  RemountEvent at_rests;
+  at_rests.first_pose_index = 7;
+  EXPECT_EQ(remountPlace(at_rests), "before pose 7");
+  RemountEvent in_motion;
+  in_motion.change_stamp_s = 30.214;
+  EXPECT_EQ(remountPlace(in_motion), "during the motion at 30.21 s");
+}
+
 TEST(CalibrationSnapshot, HowToMoveSaysTurnOrTiltFromTheAxisAndTheVertical) {
   const Eigen::Vector3d up_cam = Eigen::Vector3d(0.0, -1.0, 0.2).normalized();  // camera level-ish
   const Eigen::Vector3d horizontal = up_cam.cross(Eigen::Vector3d::UnitZ()).normalized();

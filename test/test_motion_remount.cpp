@@ -64,6 +64,13 @@ TEST(MotionRemount, AChangeDuringTheMotionIsFoundAndTheNewMountCalibrated) {
     const std::size_t at = text.find("motion at ");
     ASSERT_NE(at, std::string::npos) << text;
     EXPECT_NEAR(std::stod(text.substr(at + 10)), truth_stamp_s, 1.0) << text;
+    // The verdict names the change by its time, not by a pose (there are none).
+    EXPECT_NEAR(o.remounts[0].change_stamp_s, truth_stamp_s, 1.0);
+    ASSERT_TRUE(o.final.verdict.has_value());
+    EXPECT_FALSE(o.final.verdict->passed);
+    EXPECT_NE(o.final.verdict->text.find("during the motion at"), std::string::npos)
+        << o.final.verdict->text;
+    EXPECT_EQ(o.final.verdict->text.find("pose"), std::string::npos) << o.final.verdict->text;
     ASSERT_TRUE(o.final.result.joint && o.final.result.joint->ok) << o.final.result.message;
     const double error_deg =
         test::angleBetweenDeg(o.final.result.R_cam_imu, run.trajectory.R_cam_imu_final());

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -42,7 +43,13 @@ struct RemountEvent {
   double change_deg = 0;       ///< between the two mounts' estimates (0 when unknown: pair modes)
   std::size_t poses_kept = 0;  ///< poses of the new mount left in the window
   std::string message;
+  /// A change during continuous motion: its stamp (s, camera clock; the pose indices then name
+  /// the next pose, if any). NaN for a change between rests.
+  double change_stamp_s = std::numeric_limits<double>::quiet_NaN();
 };
+
+/// Where a remount happened, for the verdicts: "before pose 7" or "during the motion at 30.21 s".
+std::string remountPlace(const RemountEvent& event);
 
 /// The recording's verdict (calibrate_bag's "verdict:" line; the nodelet's status): would the
 /// estimate be broadcast, and was the mount one mount throughout.

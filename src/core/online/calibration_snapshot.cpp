@@ -4,11 +4,21 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <string>
 
 #include "camera_imu_alignment/pipeline/stationary_window.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {
+
+std::string remountPlace(const RemountEvent& event) {
+  if (std::isfinite(event.change_stamp_s)) {
+    char text[80];
+    std::snprintf(text, sizeof(text), "during the motion at %.2f s", event.change_stamp_s);
+    return text;
+  }
+  return "before pose " + std::to_string(event.first_pose_index);
+}
 
 std::optional<CalibrationVerdict> recordingVerdict(const EstimateEvent& estimate,
                                                    const std::vector<RemountEvent>& remounts,
@@ -21,24 +31,27 @@ std::optional<CalibrationVerdict> recordingVerdict(const EstimateEvent& estimate
     verdict.passed = false;
     verdict.text = "FAILED: " + estimate.camera_model_problem;
     if (!remounts.empty()) {
-      verdict.text += "; the mount change reported before pose " +
-                      std::to_string(remounts.front().first_pose_index) +
+      verdict.text += "; the mount change reported " + remountPlace(remounts.front()) +
                       " may be this model's error, not a remount";
     }
   } else if (!remounts.empty() && accept_last_mount) {
     const RemountEvent& last = remounts.back();
-    char change[160];
-    std::snprintf(change, sizeof(change), "the mount changed before pose %d (by %.2f deg)",
-                  last.first_pose_index, last.change_deg);
+    char size[40];
+    std::snprintf(size, sizeof(size), " (by %.2f deg)", last.change_deg);
+    const std::string change = "the mount changed " + remountPlace(last) + size;
+    const std::string after = std::isfinite(last.change_stamp_s) && estimate.window_poses == 0
+                                  ? std::string("the motion")
+                                  : "the " + std::to_string(estimate.window_poses) + " poses";
     verdict.text = gates_passed
-                       ? std::string("PASSED for the last mount (--accept-last-mount): ") + change +
-                             "; the estimate is from the " + std::to_string(estimate.window_poses) +
-                             " poses after it"
+                       ? "PASSED for the last mount (--accept-last-mount): " + change +
+                             "; the estimate is from " + after + " after it"
                        : "FAILED: " + estimate.gate.why + " (the last mount, after " + change + ")";
   } else if (!remounts.empty()) {
-    verdict.text = "FAILED: the mount changed during the recording (first before pose " +
-                   std::to_string(remounts.front().first_pose_index) +
-                   "); the estimate is of the last mount, from the poses after the change";
+    const bool motion = std::isfinite(remounts.back().change_stamp_s);
+    verdict.text = "FAILED: the mount changed during the recording (first " +
+                   remountPlace(remounts.front()) +
+                   "); the estimate is of the last mount, from the " + (motion ? "data" : "poses") +
+                   " after the change";
     if (!gates_passed) verdict.text += "; and " + estimate.gate.why;
   } else if (!gates_passed) {
     verdict.text = "FAILED: " + estimate.gate.why;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -99,7 +100,9 @@ struct OnlineCalibrator::Impl {
   void applyRemount(const SolveOutput& output);
   /// Keeps the window's poses from `kept_index` on (the mount changed before `first_index` <=
   /// kept_index) and says so (state, on_remount).
-  void restartWindowAt(int first_index, int kept_index, double change_deg, const std::string& text);
+  /// `change_stamp_s`: a change during the motion (RemountEvent::change_stamp_s), else NaN.
+  void restartWindowAt(int first_index, int kept_index, double change_deg, const std::string& text,
+                       double change_stamp_s = std::numeric_limits<double>::quiet_NaN());
   /// The output as an estimate judged by the gates against what is broadcast now.
   EstimateEvent judged(SolveOutput output) const;
   void applyEstimate(EstimateEvent event);
@@ -183,14 +186,15 @@ void OnlineCalibrator::Impl::checkPairRemount(const StationaryPose& pose) {
 }
 
 void OnlineCalibrator::Impl::restartWindowAt(int first_index, int kept_index, double change_deg,
-                                             const std::string& text) {
+                                             const std::string& text, double change_stamp_s) {
   pipeline->keepPosesFrom(kept_index);
   ++generation;  // solves still running saw the old mount's poses
   ++remounts;
   inconsistent_poses = 0;
   recalibrating = fresh_start = true;
   setState(CalibrationState::kRecalibrating, text);
-  const RemountEvent event{first_index, kept_index, change_deg, pipeline->windowSize(), text};
+  RemountEvent event{first_index, kept_index, change_deg, pipeline->windowSize(), text};
+  event.change_stamp_s = change_stamp_s;
   if (remount_events.size() >= kRemountHistory) remount_events.erase(remount_events.begin());
   remount_events.push_back(event);
   if (callbacks.on_remount) callbacks.on_remount(event);
@@ -291,7 +295,7 @@ void OnlineCalibrator::Impl::applyRemount(const SolveOutput& output) {
                   from_s);
     const std::vector<StationaryPose> kept = pipeline->windowPoses();
     const int first = kept.empty() ? next_index : kept.front().index;
-    restartWindowAt(first, first, test.change_deg, text);
+    restartWindowAt(first, first, test.change_deg, text, test.change_stamp_s);
     motion_frames_solved = pipeline->motionFrames();  // the next solve waits for new motion
     motion_frames_in_solved_window = 0;
     return;
