@@ -204,7 +204,6 @@ void OnlineCalibrator::Impl::requestSolve() {
   if (worker && settings.solves_in_order) applyFinished();  // the previous solve's, first
   motion_frames_solved = pipeline->motionFrames();
   SolveJob job;
-  job.generation = generation;
   job.inputs = inputMark();
   job.window = pipeline->snapshot();
   motion_frames_in_solved_window = job.window.joint.motion_frames.size();
@@ -241,7 +240,7 @@ void OnlineCalibrator::Impl::applyFinished() {
 }
 
 void OnlineCalibrator::Impl::apply(SolveOutput output) {
-  if (output.generation != generation) return;  // the window lost poses since: stale
+  if (output.inputs.generation != generation) return;  // the window lost poses since: stale
   if (output.result.status == SolveStatus::kBadInput) return;
   if (output.mount_test && output.mount_test->tested && !output.window.pose_indices.empty()) {
     newest_pose_change_tested =
@@ -253,8 +252,11 @@ void OnlineCalibrator::Impl::apply(SolveOutput output) {
     applyRemount(output);
     return;
   }
-  last_solved = output;
-  last_solved->mount_test.reset();
+  // For calibrateNow: the estimate and its window's poses, not the window's data.
+  last_solved.emplace();
+  last_solved->inputs = output.inputs;
+  last_solved->window.pose_indices = output.window.pose_indices;
+  last_solved->result = output.result;
   applyEstimate(judged(std::move(output)));
 }
 
@@ -438,7 +440,6 @@ CalibrateOutcome OnlineCalibrator::calibrateNow(bool force) {
     output = *impl_->last_solved;  // nothing came in since: the same window, solved
   } else {
     SolveJob job;
-    job.generation = impl_->generation;
     job.inputs = impl_->inputMark();
     job.window = impl_->pipeline->snapshot();
     output = runSolveJob(std::move(job), impl_->pipeline_settings, impl_->settings);

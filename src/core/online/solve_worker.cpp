@@ -9,7 +9,6 @@ namespace camera_imu_alignment {
 SolveOutput runSolveJob(SolveJob job, const PipelineSettings& pipeline,
                         const OnlineSettings& online) {
   SolveOutput out;
-  out.generation = job.generation;
   out.inputs = job.inputs;
   out.result = solveWindow(job.window, pipeline);
   if (job.test_mount_change && out.result.joint && out.result.joint->ok) {

@@ -27,8 +27,7 @@ struct InputMark {
 };
 
 struct SolveJob {
-  std::uint64_t generation = 0;  ///< the window's generation when taken (reset, remount, jump)
-  InputMark inputs;              ///< when the window was taken
+  InputMark inputs;  ///< when the window was taken (its generation: reset, remount, jump)
   WindowSnapshot window;
   bool test_mount_change = false;
   /// The window's newest poses that no earlier change-point test had among its poses (the
@@ -38,7 +37,6 @@ struct SolveJob {
 };
 
 struct SolveOutput {
-  std::uint64_t generation = 0;
   InputMark inputs;       ///< the job's
   WindowSnapshot window;  ///< the job's (pose indices of the estimate)
   AlignmentResult result;
