@@ -1,7 +1,6 @@
 // Calibration without a board, Monte Carlo (issue 26's targets; labelled statistical): 20 seeds of
-// the simulator's room scenarios with a consumer IMU (scene_sessions.h). Robot stops: RMS error,
-// and the reported 1-sigma covering the errors whenever the chi-square test passes. Hand-held:
-// measured and printed (not met: near-planar views, BENCHMARKS.md), never confidently wrong.
+// the simulator's room scenarios with a consumer IMU (scene_sessions.h): RMS error, answers (the
+// chi-square test passing), and the reported 1-sigma covering the errors whenever it passes.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -43,7 +42,7 @@ double rms(const std::vector<double>& v) {
   return v.empty() ? 0.0 : std::sqrt(sum / v.size());
 }
 
-// The issue's target is 0.10 deg RMS, not met: measured 0.181 (20/20 consistent, all within 3
+// The issue's target is 0.10 deg RMS, not met: measured 0.175 (20/20 consistent, all within 3
 // sigma, 1-sigma norms about 0.2 deg: the robot turns mostly about the vertical, tilted 5-20 deg;
 // 2026-11-27). Asserted: honesty, and the measured level with a margin.
 TEST(SceneMonteCarlo, RobotStopsConsumer) {
@@ -53,12 +52,14 @@ TEST(SceneMonteCarlo, RobotStopsConsumer) {
   EXPECT_LE(rms(s.error_deg), 0.25);
 }
 
-// Measured (2026-11-27): 8 of 20 consistent, RMS 0.063 deg over them, all 8 within 3 sigma; the
-// other 12 fail the chi-square test (wrong rotations from near-planar views outnumber what the
-// screening removes): no confident wrong answer, but no answer either.
-TEST(SceneMonteCarlo, HandHeldConsumerNeverConfidentlyWrong) {
+// The issue's target: 0.08 deg RMS, honest. Measured (2026-11-27, fifth session): 20 of 20
+// consistent at 0.0625 deg RMS, all within 3 sigma (before the near-planar views' other solutions
+// and the gyro's consensus: 8 of 20 answered, the other 12 failed the chi-square test).
+TEST(SceneMonteCarlo, HandHeldConsumer) {
   const Statistics s = runSeeds("room_handheld");
+  EXPECT_GE(s.consistent, 18);
   EXPECT_EQ(s.within_3_sigma, s.consistent);
+  EXPECT_LE(rms(s.error_deg), 0.08);
 }
 
 }  // namespace

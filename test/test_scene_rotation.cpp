@@ -5,9 +5,11 @@
 // ViSP's hand-eye rotation (skipped without the data), and bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <opencv2/imgcodecs.hpp>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -62,7 +64,8 @@ Eigen::Vector3d bearingOfPixel(const Eigen::Vector2d& px) {
 }
 
 AnalyticViews analyticViews(std::mt19937_64& rng, const Eigen::Matrix3d& R_from_to,
-                            const Eigen::Vector3d& t_from, double outliers, int points) {
+                            const Eigen::Vector3d& t_from, double outliers, int points,
+                            const std::optional<Eigen::Vector4d>& plane = std::nullopt) {
   std::uniform_real_distribution<double> u(0, 1);
   std::normal_distribution<double> noise(0, kNoisePx);
   AnalyticViews v;
@@ -70,8 +73,11 @@ AnalyticViews analyticViews(std::mt19937_64& rng, const Eigen::Matrix3d& R_from_
   v.to.descriptors = cv::Mat(0, 128, CV_32F);
   while (static_cast<int>(v.from.bearings.size()) < points) {
     const Eigen::Vector2d px_from(u(rng) * kWidth, u(rng) * kHeight);
-    const Eigen::Vector3d p_from =
-        (2 + 3 * u(rng)) * bearingOfPixel(px_from) / bearingOfPixel(px_from).z();
+    const Eigen::Vector3d ray = bearingOfPixel(px_from) / bearingOfPixel(px_from).z();
+    // On the plane n.p = d (`from` frame) when given, else at a depth of 2-5 m.
+    const double depth = plane ? plane->w() / plane->head<3>().dot(ray) : 2 + 3 * u(rng);
+    if (!(depth > 0.5)) continue;
+    const Eigen::Vector3d p_from = depth * ray;
     const Eigen::Vector3d p_to = R_from_to.transpose() * (p_from - t_from);
     if (p_to.z() < 0.5) continue;
     Eigen::Vector2d px_to(kF * p_to.x() / p_to.z() + kWidth / 2.0,
@@ -138,6 +144,51 @@ TEST(SceneRotation, AnalyticBearingsRecoverRotationModelAndHonestCovariance) {
     EXPECT_GE(within_3_sigma, 0.95 * kSeeds) << c.name;
     EXPECT_LT(max_error_deg, c.baseline_m > 0 ? 0.3 : 0.05) << c.name;
   }
+}
+
+// A wall (one plane 2 m away, tilted 20-40 deg) seen from two places 10-20 cm apart, turned 20-40
+// deg: the essential matrix has two solutions that explain the matches about equally. Whichever
+// the fit takes, the truth is near one of the chosen rotation and its alternatives (which the gyro
+// then chooses between: estimation/camera_link_consensus.h).
+TEST(SceneRotation, ANearPlanarViewKeepsItsOtherSolution) {
+  const CameraIntrinsics intrinsics = syntheticIntrinsics();
+  int wrong_chosen = 0, with_alternatives = 0, near_truth = 0;
+  for (int seed = 0; seed < 20; ++seed) {
+    std::mt19937_64 rng(7000 + seed);
+    std::uniform_real_distribution<double> u(0, 1);
+    const Eigen::Matrix3d R_from_to =
+        test::axisAngle(test::randomUnitVector(rng), (20 + 20 * u(rng)) * M_PI / 180);
+    const Eigen::Vector3d t_from = (0.1 + 0.1 * u(rng)) * test::randomUnitVector(rng);
+    const double tilt = (20 + 20 * u(rng)) * M_PI / 180;
+    const Eigen::Vector3d normal(std::sin(tilt), 0, std::cos(tilt));
+    const AnalyticViews v = analyticViews(rng, R_from_to, t_from, 0.1, 300,
+                                          Eigen::Vector4d(normal.x(), 0, normal.z(), 2.0));
+    const SceneRotation r =
+        estimateSceneRotation(v.from, v.to, intrinsics, std::nullopt, SceneRotationSettings());
+    ASSERT_TRUE(r.ok) << "seed " << seed << ": " << r.message;
+    double best = errorDeg(r, R_from_to);
+    wrong_chosen += best > 0.5;
+    with_alternatives += !r.alternatives.empty();
+    for (const SceneRotationAlternative& a : r.alternatives) {
+      EXPECT_GT(a.inliers, 0) << "seed " << seed;
+      EXPECT_TRUE(a.cov_rad2.allFinite());
+      best = std::min(best, rad2deg(geodesicDistance(a.R_from_to, R_from_to)));
+    }
+    if (std::getenv("CIA_VERBOSE")) {
+      std::printf("seed %d: chosen %.3f deg off, nearest solution %.3f deg, %zu alternatives\n",
+                  seed, errorDeg(r, R_from_to), best, r.alternatives.size());
+    }
+    near_truth += best < 0.4;
+  }
+  std::printf(
+      "20 planar pairs: %d took a solution over 0.5 deg off, %d have alternatives, %d have one "
+      "within 0.4 deg\n",
+      wrong_chosen, with_alternatives, near_truth);
+  // Measured (2026-11-27): 15 chosen 1.4-4.5 deg off; the nearest solution within 0.03-0.38 deg
+  // on 18 (an exact plane is the essential matrix's degenerate case: the refined alternative is
+  // near, not at, the truth), 0.56 and 1.42 deg on the other two.
+  EXPECT_GE(near_truth, 17);
+  EXPECT_GE(with_alternatives, wrong_chosen);
 }
 
 // Known limitation, measured, not asserted (run with --gtest_also_run_disabled_tests): baselines of

@@ -108,6 +108,14 @@ struct CameraLink {
   Eigen::Matrix3d R_from_to = Eigen::Matrix3d::Identity();
   /// Covariance (rad^2, `to` camera axes, right perturbation R_from_to Exp(delta)).
   Eigen::Matrix3d cov_rad2 = Eigen::Matrix3d::Zero();
+  /// Other rotations the views explain about as well (a near-planar view's second essential
+  /// matrix; vision/scene_rotation.h), same frames: the screening (camera_link_screening.h) takes
+  /// one in place of R_from_to when the IMU's measurements say so.
+  struct Alternative {
+    Eigen::Matrix3d R_from_to = Eigen::Matrix3d::Identity();
+    Eigen::Matrix3d cov_rad2 = Eigen::Matrix3d::Zero();
+  };
+  std::vector<Alternative> alternatives;
 };
 
 /// Raw gyro samples from the end of rest `from_pose` to the start of rest `to_pose`. Sample i holds

@@ -56,6 +56,7 @@
 #include <string>
 #include <vector>
 
+#include "camera_imu_alignment/estimation/camera_link_consensus.h"
 #include "camera_imu_alignment/estimation/joint_types.h"
 #include "camera_imu_alignment/inertial/imu_attitude.h"
 #include "camera_imu_alignment/inertial/inertial_samples.h"
@@ -146,6 +147,8 @@ struct SceneLinkSummary {
   double sigma_deg = 0.0;  ///< RMS 1-sigma per axis of the measured rotation
   /// The measured rotation (vision/scene_rotation.h: R_G_cam_this = R_G_cam_from R_from_to).
   Eigen::Matrix3d R_from_to = Eigen::Matrix3d::Identity();
+  /// Other rotations that explain the matches about as well (SceneRotation::alternatives).
+  std::vector<Eigen::Matrix3d> alternatives;
 };
 
 /// A stationary pose as the pipeline assembled it.
@@ -197,6 +200,9 @@ struct WindowSnapshot {
   RotationPairs pairs;  ///< StationaryWindow::pairs
   JointProblem joint;   ///< the joint estimator's problem (imu_orientation: joint or magnetometer)
   std::vector<int> pose_indices;  ///< StationaryPose::index of each window pose, oldest first
+  /// The natural-scene links' solutions as the gyro's consensus chose them
+  /// (estimation/camera_link_consensus.h; joint.camera_links hold the chosen ones).
+  CameraLinkConsensus link_consensus;
 };
 
 /// The solve of a window: the pair estimators, then (imu_orientation: joint or

@@ -138,10 +138,21 @@ struct JointResult {
   /// dof when the model holds; robust loss not applied). For a link left out (below), its value in
   /// the solve that left it out.
   std::vector<double> camera_link_chi2;
+  /// Per JointProblem::camera_links entry: its residual Log(R_measured^T R_fit) (rad, `to`
+  /// camera axes), zero for a link left out.
+  std::vector<Eigen::Vector3d> camera_link_residual_rad;
+  /// Isotropic variance added to every camera link's covariance (rad^2 per axis) because the
+  /// links' residuals exceeded their covariances (JointSettings::camera_excess_level): the
+  /// natural scene's rotations as the recording shows them. 0 when not.
+  double camera_link_excess_variance_rad2 = 0;
   /// Camera links (indices into JointProblem::camera_links) this estimate left out as outliers
   /// (the pipeline's screening of natural-scene rotations): a comparison of models on the same
   /// measurements (the mount-change test) leaves them out too. Sorted.
   std::vector<int> camera_links_left_out;
+  /// Per JointProblem::camera_links entry (empty when the problem has none or none was screened):
+  /// -1 where the link's measured rotation was used, else the index into its alternatives of the
+  /// rotation the screening took instead.
+  std::vector<int> camera_link_alternative_used;
   /// Poses whose field was left out as disturbed: it did not fit the calibrated iron and field.
   std::vector<int> mag_poses_left_out;
   /// The camera-IMU time offset (Kalibr's timeshift_cam_imu: t_imu = t_cam + timeshift; s) and

@@ -69,6 +69,18 @@ struct SceneRotationSettings {
   /// A gyro-predicted rotation further than this (deg) from the estimate fails the pair
   /// (a repetitive texture's wrong but consistent matches); 0: not checked.
   double max_prediction_difference_deg = 5.0;
+  /// A near-planar view's other essential matrix is kept as an alternative (SceneRotation) when it
+  /// holds at least this share of the chosen model's inliers.
+  double alternative_inlier_share = 0.9;
+};
+
+/// Another rotation that explains the matches about as well as the chosen one (a near-planar
+/// view's second essential matrix): the joint estimate may take it instead when the IMU says so.
+struct SceneRotationAlternative {
+  Eigen::Matrix3d R_from_to = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d cov_rad2 = Eigen::Matrix3d::Zero();  ///< `to` camera axes, right perturbation
+  int inliers = 0;
+  double residual_rms_px = 0;
 };
 
 /// The camera's rotation between two views, with what the fit says about it.
@@ -85,6 +97,9 @@ struct SceneRotation {
   /// The inliers' noise per image coordinate under the chosen model (pixels): the RMS of their
   /// first-order geometric distances over the degrees of freedom; the sigma of cov_rad2.
   double residual_rms_px = 0;
+  /// Other solutions holding at least SceneRotationSettings::alternative_inlier_share of the
+  /// chosen model's inliers, more than 3 of its sigmas away from it.
+  std::vector<SceneRotationAlternative> alternatives;
 };
 
 /// The rotation between two views. `R_from_to_prediction` (e.g. the gyro's, through the current

@@ -1,5 +1,6 @@
 // The camera's noise as the recording shows it (JointSettings::camera_excess_level): the
-// isotropic variance real PnP errors add to the rests' stated camera covariances.
+// isotropic variance real errors add to the stated covariances of the rests' camera orientations
+// (PnP) and of the natural scene's rotations between rests (camera links).
 #pragma once
 
 #include "camera_imu_alignment/estimation/joint_types.h"
@@ -15,5 +16,15 @@ namespace joint {
 double cameraExcessVariance(const JointProblem& problem, const JointResult& result,
                             const JointSettings& settings);
 
+/// The same for the camera links (result.camera_link_residual_rad): features whose positions
+/// shift with the viewpoint (a 20-60 deg turn changes a texture's look) err beyond the two-view
+/// fit's covariance, which sees only their scatter.
+double cameraLinkExcessVariance(const JointProblem& problem, const JointResult& result,
+                                const JointSettings& settings);
+
 }  // namespace joint
+
+/// Adds `variance_rad2` x I to every camera link's covariance.
+void addCameraLinkExcessVariance(double variance_rad2, JointProblem* problem);
+
 }  // namespace camera_imu_alignment

@@ -3,10 +3,42 @@
 
 #include <algorithm>
 #include <numeric>
+#include <optional>
 #include <utility>
 #include <vector>
 
 namespace camera_imu_alignment {
+namespace {
+
+/// The solve with link `j` measured as its alternative `a` instead, when that link then fits
+/// (its chi-square below the outlier bound); of several such, the lowest total chi-square.
+std::optional<std::pair<int, JointResult>> bestAlternative(const JointEstimator& estimator,
+                                                           const JointProblem& problem,
+                                                           std::size_t j,
+                                                           const Eigen::Matrix3d& R_start,
+                                                           JointProblem* swapped_problem) {
+  std::optional<std::pair<int, JointResult>> best;
+  const CameraLink& link = problem.camera_links[j];
+  for (std::size_t a = 0; a < link.alternatives.size(); ++a) {
+    JointProblem swapped = problem;
+    CameraLink& measured = swapped.camera_links[j];
+    measured.R_from_to = link.alternatives[a].R_from_to;
+    measured.cov_rad2 = link.alternatives[a].cov_rad2;
+    measured.alternatives.clear();  // chosen once: no going back and forth
+    JointResult again = estimator.solve(swapped, R_start);
+    if (!again.ok || again.camera_link_chi2.size() != swapped.camera_links.size() ||
+        again.camera_link_chi2[j] >= kCameraLinkOutlierChi2) {
+      continue;
+    }
+    if (!best || again.chi2 < best->second.chi2) {
+      best.emplace(static_cast<int>(a), std::move(again));
+      *swapped_problem = std::move(swapped);
+    }
+  }
+  return best;
+}
+
+}  // namespace
 
 JointResult solveScreeningCameraLinks(const JointEstimator& estimator, JointProblem problem,
                                       const Eigen::Matrix3d& R_start) {
@@ -16,12 +48,24 @@ JointResult solveScreeningCameraLinks(const JointEstimator& estimator, JointProb
   std::vector<int> caller_index(links);  // of each link still in `problem`
   std::iota(caller_index.begin(), caller_index.end(), 0);
   std::vector<std::pair<int, double>> left_out;  // caller's index, chi-square when left out
-  while (joint.ok && left_out.size() < max_left_out &&
-         joint.camera_link_chi2.size() == problem.camera_links.size()) {
+  std::vector<int> alternative_used(links, -1);  // caller's indices
+  bool swapped_any = false;
+  while (joint.ok && joint.camera_link_chi2.size() == problem.camera_links.size()) {
     const auto worst =
         std::max_element(joint.camera_link_chi2.begin(), joint.camera_link_chi2.end());
     if (worst == joint.camera_link_chi2.end() || *worst < kCameraLinkOutlierChi2) break;
     const auto j = worst - joint.camera_link_chi2.begin();
+    // A link whose other solution fits is measured by it (each link's alternatives are tried
+    // once: a swapped link has none left, so the loop ends).
+    JointProblem swapped;
+    if (auto alternative = bestAlternative(estimator, problem, j, joint.R_cam_imu, &swapped)) {
+      alternative_used[caller_index[j]] = alternative->first;
+      swapped_any = true;
+      problem = std::move(swapped);
+      joint = std::move(alternative->second);
+      continue;
+    }
+    if (left_out.size() >= max_left_out) break;
     JointProblem without = problem;
     without.camera_links.erase(without.camera_links.begin() + j);
     JointResult again = estimator.solve(without, joint.R_cam_imu);
@@ -31,6 +75,7 @@ JointResult solveScreeningCameraLinks(const JointEstimator& estimator, JointProb
     problem = std::move(without);
     joint = std::move(again);
   }
+  if (swapped_any) joint.camera_link_alternative_used = alternative_used;
   if (left_out.empty() || joint.camera_link_chi2.size() != caller_index.size()) return joint;
   // In the caller's indices; a link left out keeps its chi-square of the solve that left it out.
   std::vector<double> chi2(links, 0.0);

@@ -456,22 +456,27 @@ namespace {
 constexpr double kExcessSettled = 0.05;
 constexpr int kMaxExcessRounds = 4;
 
-/// The camera's measured excess noise added to the rests and the window solved again until it
-/// settles (JointSettings::camera_excess_level).
+/// The camera's measured excess noise added to the rests and to the camera links, and the window
+/// solved again until both settle (JointSettings::camera_excess_level).
 JointResult withCameraNoiseAsMeasured(JointProblem* problem, JointResult chosen,
                                       const Eigen::Matrix3d& R_cam_imu_initial,
                                       const JointSettings& settings) {
   if (!(settings.camera_excess_level > 0.0) || !settings.compute_covariance) return chosen;
-  double excess = 0.0;
+  double excess = 0.0, link_excess = 0.0;
   for (int round = 0; round < kMaxExcessRounds && chosen.ok; ++round) {
-    const double more = joint::cameraExcessVariance(*problem, chosen, settings);
-    if (!(more > kExcessSettled * excess)) break;
+    double more = joint::cameraExcessVariance(*problem, chosen, settings);
+    double more_links = joint::cameraLinkExcessVariance(*problem, chosen, settings);
+    if (!(more > kExcessSettled * excess)) more = 0.0;
+    if (!(more_links > kExcessSettled * link_excess)) more_links = 0.0;
+    if (more == 0.0 && more_links == 0.0) break;
     JointProblem inflated = *problem;
     addCameraExcessVariance(more, &inflated);
+    addCameraLinkExcessVariance(more_links, &inflated);
     JointResult again = screenMagnetometer(inflated, R_cam_imu_initial, settings);
     if (!again.ok) break;  // the last usable estimate stands
     *problem = std::move(inflated);
     excess += more;
+    link_excess += more_links;
     chosen = std::move(again);
   }
   if (excess > 0.0) {
@@ -482,8 +487,17 @@ JointResult withCameraNoiseAsMeasured(JointProblem* problem, JointResult chosen,
                   "model, intrinsics, board flatness)",
                   rad2deg(std::sqrt(excess)));
     chosen.notes.push_back(buffer);
-    chosen.camera_excess_variance_rad2 = excess;
   }
+  if (link_excess > 0.0) {
+    char buffer[240];
+    std::snprintf(buffer, sizeof(buffer),
+                  "the natural scene's rotations scatter beyond their two-view covariance: %.3f "
+                  "deg per axis added to each (features that shift with the viewpoint)",
+                  rad2deg(std::sqrt(link_excess)));
+    chosen.notes.push_back(buffer);
+  }
+  chosen.camera_excess_variance_rad2 = excess;
+  chosen.camera_link_excess_variance_rad2 = link_excess;
   return chosen;
 }
 

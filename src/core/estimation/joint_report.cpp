@@ -1,6 +1,7 @@
 // Covariance, consistency and the reported IMU model of the joint estimator.
 #include <ceres/covariance.h>
 
+#include <Eigen/LU>
 #include <boost/math/special_functions/gamma.hpp>
 
 #include <algorithm>
@@ -77,6 +78,7 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
   Eigen::VectorXd r(16);
   result->mag_residual_chi2.assign(n, 0.0);
   result->camera_link_chi2.assign(problem.camera_links.size(), 0.0);
+  result->camera_link_residual_rad.assign(problem.camera_links.size(), Eigen::Vector3d::Zero());
   result->camera_residual_rad.assign(n, Eigen::Vector3d::Zero());
   for (size_t k = 0; k < n; ++k) {
     if (problem.poses[k].camera_absolute) {  // a rest's PnP or a motion node's
@@ -90,7 +92,16 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
     const double squared = r.squaredNorm();
     chi2 += squared;
     if (record.magnetometer && record.pose >= 0) result->mag_residual_chi2[record.pose] = squared;
-    if (record.camera_link >= 0) result->camera_link_chi2[record.camera_link] = squared;
+    if (record.camera_link >= 0) {
+      result->camera_link_chi2[record.camera_link] = squared;
+      // Unwhitened: the residual is L^-1 Log(R_measured^T R_fit).
+      Eigen::Matrix3d whitening;
+      if (whiteningMatrix(problem.camera_links[record.camera_link].cov_rad2,
+                          settings.camera_sigma_floor_rad, &whitening)) {
+        result->camera_link_residual_rad[record.camera_link] =
+            whitening.lu().solve(Eigen::Vector3d(r.head<3>()));
+      }
+    }
     residual_count += record.size;
     if (record.pose < 0) continue;
     const double share = record.other_pose >= 0 ? 0.5 : 1.0;

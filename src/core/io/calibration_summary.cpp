@@ -164,7 +164,8 @@ void writeScenePoses(std::ostream& out, const ReportInput& in) {
   for (const StationaryPose& p : in.poses) any = any || p.camera_source == PoseCameraSource::kScene;
   if (!any) return;
   out << "camera from the natural scene (no target): per pose its features and the rotations "
-         "measured from earlier rests (matches, inliers, model, 1-sigma per axis):\n";
+         "measured from earlier rests (matches, inliers, model, 1-sigma per axis; the other "
+         "solutions the gyro chooses between):\n";
   for (const StationaryPose& p : in.poses) {
     if (p.camera_source != PoseCameraSource::kScene) continue;
     out << "  pose " << std::setw(3) << p.index << "  scene " << p.scene << "  " << p.scene_features
@@ -175,6 +176,10 @@ void writeScenePoses(std::ostream& out, const ReportInput& in) {
           << link.inliers << " inliers, "
           << (link.model == SceneMotionModel::kGeneral ? "general" : "rotation-only") << ", "
           << fixed(link.sigma_deg, 3) << " deg";
+      if (!link.alternatives.empty()) {
+        out << ", " << link.alternatives.size() << " other solution"
+            << (link.alternatives.size() > 1 ? "s" : "") << " (a near-planar view)";
+      }
     }
     out << "\n";
     if (!p.scene_note.empty()) out << "    " << p.scene_note << "\n";

@@ -366,8 +366,30 @@ WindowSnapshot CalibrationPipeline::Impl::snapshot() const {
     addMotion(window_poses.empty() ? -1e300 : window_poses.front().start_s, &out.joint);
   }
   for (const StationaryPose& pose : window.poses()) out.pose_indices.push_back(pose.index);
+  // A near-planar view's two solutions: the one the gyro agrees with.
+  if (!out.joint.camera_links.empty()) out.link_consensus = chooseCameraLinkSolutions(&out.joint);
   return out;
 }
+
+namespace {
+
+/// How many natural-scene rotations were taken as a near-planar view's other solution, by the
+/// gyro's consensus (WindowSnapshot::link_consensus) and by the joint estimate's screening.
+std::string otherSolutions(const WindowSnapshot& window, const JointResult& joint) {
+  const auto taken = [](const std::vector<int>& used) {
+    return std::count_if(used.begin(), used.end(), [](int a) { return a >= 0; });
+  };
+  const auto by_gyro = taken(window.link_consensus.alternative_used);
+  const auto by_screening = taken(joint.camera_link_alternative_used);
+  if (by_gyro + by_screening == 0) return "";
+  std::ostringstream s;
+  s << " (" << by_gyro + by_screening << " of them the view's other solution: " << by_gyro
+    << " by the gyro's consensus of " << window.link_consensus.consensus << " of "
+    << window.link_consensus.links_judged << ", " << by_screening << " by the screening)";
+  return s.str();
+}
+
+}  // namespace
 
 AlignmentResult solveWindow(const WindowSnapshot& window_in, const PipelineSettings& settings) {
   WindowSnapshot window = window_in;
@@ -413,7 +435,7 @@ AlignmentResult solveWindow(const WindowSnapshot& window_in, const PipelineSetti
         window.joint.camera_links.empty()
             ? ""
             : ", " + std::to_string(window.joint.camera_links.size() - links_dropped) +
-                  " natural-scene rotations" +
+                  " natural-scene rotations" + otherSolutions(window, joint) +
                   (links_dropped > 0 ? " (" + std::to_string(links_dropped) +
                                            " more left out: residual beyond chi-square(3) "
                                            "p 1e-4)"

@@ -30,6 +30,8 @@ constexpr int kRansacMaxIterations = 1000;
 constexpr double kRansacConfidence = 0.999;
 constexpr int kRefinementRounds = 4;
 constexpr double kLeverageGate = 0.2;  // a match's leverage (hat-matrix trace) to be cross-checked
+/// Triangulated depths (in baselines) up to which cheirality is judged in recoverPose.
+constexpr double kCheiralityMaxDepth = 1e6;
 constexpr double kCauchyScale2 = 2.385 * 2.385;  // Cauchy loss scale (per coordinate, in sigmas)
 
 /// The model's state: the rotation and (general model) the translation direction.
@@ -382,7 +384,11 @@ ModelFit fitGeneral(const BearingMatches& m, double threshold_px, bool screen) {
                                          kRansacConfidence, threshold_px / focal, mask);
   if (E.rows < 3 || E.cols != 3) return ModelFit();
   cv::Mat R_cv, t_cv;
-  if (cv::recoverPose(E.rowRange(0, 3), to, from, R_cv, t_cv, 1.0, cv::Point2d(0, 0), mask) < 6) {
+  // Cheirality over every depth: OpenCV's default counts points beyond 50 baselines as at
+  // infinity and not in front, which fails a hand-held rig's few centimetres before a wall metres
+  // away (the rotation-only model then took the translation as a rotation, 0.2-1.3 deg off).
+  if (cv::recoverPose(E.rowRange(0, 3), to, from, cv::Mat::eye(3, 3, CV_64F), R_cv, t_cv,
+                      kCheiralityMaxDepth, mask) < 6) {
     return ModelFit();
   }
   State s;
@@ -402,6 +408,49 @@ ModelFit fitGeneralFrom(const BearingMatches& m, double threshold_px, const Matr
   s.R = projectToSO3(R_from_to);
   s.t = t_from.normalized();
   return refineAndSelect(m, s, threshold_px, true, true);
+}
+
+std::vector<ModelFit> planarAlternatives(const BearingMatches& m, const ModelFit& fit,
+                                         double threshold_px, double min_separation_rad) {
+  std::vector<ModelFit> out;
+  if (!fit.found || fit.inlier.size() != m.from.size()) return out;
+  std::vector<cv::Point2d> to, from;
+  for (size_t i = 0; i < m.from.size(); ++i) {
+    if (!fit.inlier[i]) continue;
+    to.emplace_back(m.to[i].x() / m.to[i].z(), m.to[i].y() / m.to[i].z());
+    from.emplace_back(m.from[i].x() / m.from[i].z(), m.from[i].y() / m.from[i].z());
+  }
+  if (to.size() < 8) return out;
+  // `from` ~ H `to`, H = R_from_to + t_from n^T / d (OpenCV: points2 ~ H points1).
+  const double focal = std::sqrt(m.fx * m.fy);
+  const cv::Mat H = cv::findHomography(to, from, cv::RANSAC, threshold_px / focal);
+  if (H.rows != 3 || H.cols != 3) return out;
+  std::vector<cv::Mat> rotations, translations, normals;
+  cv::decomposeHomographyMat(H, cv::Mat::eye(3, 3, CV_64F), rotations, translations, normals);
+  std::vector<Matrix3d> kept = {fit.R_from_to};
+  for (size_t k = 0; k < rotations.size(); ++k) {
+    Matrix3d R;
+    Vector3d t;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) R(r, c) = rotations[k].at<double>(r, c);
+      t(r) = translations[k].at<double>(r);
+    }
+    R = projectToSO3(R);
+    if (!R.allFinite() || !(t.norm() > 1e-9)) continue;
+    const auto near = [&](const Matrix3d& other) {
+      return rotationAngle(other.transpose() * R) < min_separation_rad;
+    };
+    if (std::any_of(kept.begin(), kept.end(), near)) continue;
+    ModelFit alternative = fitGeneralFrom(m, threshold_px, R, t);
+    if (!alternative.found) continue;
+    const auto near_refined = [&](const Matrix3d& other) {
+      return rotationAngle(other.transpose() * alternative.R_from_to) < min_separation_rad;
+    };
+    if (std::any_of(kept.begin(), kept.end(), near_refined)) continue;
+    kept.push_back(alternative.R_from_to);
+    out.push_back(std::move(alternative));
+  }
+  return out;
 }
 
 double gric(const ModelFit& fit, const std::vector<bool>& counted, double sigma_px,

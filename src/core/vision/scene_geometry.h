@@ -58,6 +58,14 @@ ModelFit fitGeneral(const BearingMatches& matches, double threshold_px, bool scr
 ModelFit fitGeneralFrom(const BearingMatches& matches, double threshold_px,
                         const Eigen::Matrix3d& R_from_to, const Eigen::Vector3d& t_from);
 
+/// The other general-model solutions a near-planar view allows: a homography fitted to the
+/// matches `fit` holds (inliers), decomposed (up to four rotations with their translation and
+/// plane), each refined over all matches like fitGeneralFrom. Solutions within `min_separation_rad`
+/// of `fit` or of one another are dropped; those found are returned whatever their inlier counts
+/// (the caller judges them against `fit`).
+std::vector<ModelFit> planarAlternatives(const BearingMatches& matches, const ModelFit& fit,
+                                         double threshold_px, double min_separation_rad);
+
 /// Torr's GRIC of a fit (lower is better) over the matches flagged in `counted`, with the
 /// common noise `sigma_px`: sum of min(d^2 / sigma^2, 2 codim) + n d ln 4 + k ln 4n, where
 /// d = 4 - codim is the model manifold's dimension and k its parameter count (3 or 5).

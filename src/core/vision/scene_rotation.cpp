@@ -243,6 +243,23 @@ SceneRotation estimateSceneRotation(const SceneFeatures& from, const SceneFeatur
       return result;
     }
   }
+  // The other solutions a near-planar view allows (from the general model's inliers; a
+  // rotation-only choice on such a view may be a small translation absorbed as a rotation).
+  if (general.found) {
+    const double sigma_rad = std::sqrt(std::max(fit.cov_rad2.trace() / 3.0, 0.0));
+    const double separation = std::max(3.0 * sigma_rad, 1e-4);
+    std::vector<scene_geometry::ModelFit> others = scene_geometry::planarAlternatives(
+        matches, general, settings.ransac_threshold_px, separation);
+    if (use_rotation) others.insert(others.begin(), general);
+    for (const scene_geometry::ModelFit& other : others) {
+      // Against the general model's own count (the two models select inliers differently).
+      if (other.inliers < settings.alternative_inlier_share * general.inliers) continue;
+      if (rotationAngle(other.R_from_to.transpose() * fit.R_from_to) < separation) continue;
+      if (!other.cov_rad2.allFinite()) continue;
+      result.alternatives.push_back(
+          {other.R_from_to, other.cov_rad2, other.inliers, other.sigma_px});
+    }
+  }
   result.ok = true;
   result.message = why.str();
   return result;
