@@ -14,7 +14,8 @@ namespace camera_imu_alignment {
 namespace {
 
 struct Statistics {
-  std::vector<double> error_deg;  ///< of the consistent estimates
+  std::vector<double> error_deg;        ///< of the consistent estimates
+  std::vector<double> board_error_deg;  ///< the same seeds with a board at every rest
   int consistent = 0, within_3_sigma = 0, seeds = 0;
 };
 
@@ -23,6 +24,7 @@ Statistics runSeeds(const std::string& scenario) {
   for (std::uint64_t seed = 100; seed < 120; ++seed) {
     const test::SceneOutcome o = test::runScene(scenario, seed);
     ++s.seeds;
+    s.board_error_deg.push_back(o.board_error_deg);
     if (!o.consistent) continue;
     ++s.consistent;
     s.error_deg.push_back(o.error_deg);
@@ -30,9 +32,14 @@ Statistics runSeeds(const std::string& scenario) {
   }
   double sum = 0;
   for (double e : s.error_deg) sum += e * e;
-  std::printf("%s, %d seeds: %d consistent, RMS %.4f deg over them, %d within 3 sigma\n",
-              scenario.c_str(), s.seeds, s.consistent,
-              s.error_deg.empty() ? 0.0 : std::sqrt(sum / s.error_deg.size()), s.within_3_sigma);
+  double board_sum = 0;
+  for (double e : s.board_error_deg) board_sum += e * e;
+  std::printf(
+      "%s, %d seeds: %d consistent, RMS %.4f deg over them, %d within 3 sigma; a board at every "
+      "rest: RMS %.4f deg\n",
+      scenario.c_str(), s.seeds, s.consistent,
+      s.error_deg.empty() ? 0.0 : std::sqrt(sum / s.error_deg.size()), s.within_3_sigma,
+      std::sqrt(board_sum / s.board_error_deg.size()));
   return s;
 }
 
@@ -52,14 +59,16 @@ TEST(SceneMonteCarlo, RobotStopsConsumer) {
   EXPECT_LE(rms(s.error_deg), 0.25);
 }
 
-// The target: 0.08 deg RMS, honest. Measured (2026-11-27, fifth session): 20 of 20
-// consistent at 0.0625 deg RMS, all within 3 sigma (before the near-planar views' other solutions
-// and the gyro's consensus: 8 of 20 answered, the other 12 failed the chi-square test).
+// The target: 0.08 deg RMS and at most 1.5x the board's error on the same motion, honest.
+// Measured (2026-11-27, fifth session): 20 of 20 consistent at 0.0625 deg RMS, all within 3 sigma;
+// a board at every rest (scene_sessions.h) 0.0652 deg (before the near-planar views' other
+// solutions and the gyro's consensus: 8 of 20 answered, the other 12 failed the chi-square test).
 TEST(SceneMonteCarlo, HandHeldConsumer) {
   const Statistics s = runSeeds("room_handheld");
   EXPECT_GE(s.consistent, 18);
   EXPECT_EQ(s.within_3_sigma, s.consistent);
   EXPECT_LE(rms(s.error_deg), 0.08);
+  EXPECT_LE(rms(s.error_deg), 1.5 * rms(s.board_error_deg));
 }
 
 }  // namespace
