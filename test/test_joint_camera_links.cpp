@@ -10,11 +10,13 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "camera_imu_alignment/estimation/camera_link_consensus.h"
 #include "camera_imu_alignment/estimation/camera_link_screening.h"
 #include "camera_imu_alignment/estimation/joint_estimator.h"
+#include "camera_imu_alignment/io/joint_yaml.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "joint_problem_simulation.h"
 #include "joint_test_helpers.h"
@@ -294,6 +296,11 @@ TEST(JointCameraLinks, TheLinksExcessNoiseIsMeasured) {
     consistent += r.consistent();
     within += errorDeg(r, noisy) < 3.0 * r.std_dev_deg.norm();
     excess_deg.push_back(rad2deg(std::sqrt(r.camera_link_excess_variance_rad2)));
+    // The result YAML states it (doc/CONVENTIONS.md).
+    const std::string yaml = jointToYaml(r);
+    const std::size_t key = yaml.find("scene_link_excess_sigma_deg: ");
+    ASSERT_NE(key, std::string::npos) << yaml;
+    EXPECT_NEAR(std::stod(yaml.substr(key + 29)), excess_deg.back(), 1e-4);
     EXPECT_TRUE(std::any_of(r.notes.begin(), r.notes.end(), [](const std::string& n) {
       return n.find("natural scene's rotations scatter") != std::string::npos;
     }));

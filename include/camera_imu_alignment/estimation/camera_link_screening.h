@@ -1,8 +1,11 @@
 // The joint estimate with camera links screened (JointProblem::camera_links, the natural scene): a
 // wrong rotation between two views (a near-planar view's two-fold ambiguity, repeated texture)
 // stands out by its residual; the link with the largest whitened residual beyond the chi-square(3)
-// tail at kCameraLinkOutlierChi2 is left out and the problem solved again, at most a third of the
-// links. The result names the links left out (JointResult::camera_links_left_out).
+// tail at kCameraLinkOutlierChi2 is first measured by each of its other solutions
+// (CameraLink::alternatives) and keeps the one under which it fits (the lowest chi-square; each
+// link's alternatives are tried once); if none fits it is left out and the problem solved again,
+// at most a third of the links. The result names the links left out
+// (JointResult::camera_links_left_out) and the solutions taken (camera_link_alternative_used).
 //
 // Comparing two models of one problem (the mount-change test) each screened on its own, a link left
 // out costs kCameraLinkOutlierChi2 and counts with its 3 residuals (trimmedChi2, trimmedDof): a

@@ -61,6 +61,8 @@ std::string jointToYaml(const JointResult& j) {
   out << "  covariance_scale: " << j.covariance_scale << "  # chi2/dof when > 1, applied\n";
   out << "  camera_excess_sigma_deg: " << rad2deg(std::sqrt(j.camera_excess_variance_rad2))
       << "  # added to each rest's camera 1-sigma per axis (its noise as measured); 0: none\n";
+  out << "  scene_link_excess_sigma_deg: " << rad2deg(std::sqrt(j.camera_link_excess_variance_rad2))
+      << "  # added to each natural-scene rotation's 1-sigma per axis; 0: none\n";
   out << "  std_dev_deg: " << flow(j.std_dev_deg) << "  # 1-sigma about the camera x, y, z axes\n";
   out << "  data_used: " << dataUsed(j) << "  # rests, motion or both\n";
   out << "  rests: " << j.rests_used << "\n";
