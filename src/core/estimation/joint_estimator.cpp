@@ -195,8 +195,8 @@ JointResult solveModel(const JointProblem& problem, const Eigen::Matrix3d& R_cam
     gyro_settled = gyroModelChange(problem, state, gyro) < kRelinearisationThreshold;
     const bool last = pass + 1 == settings.max_relinearisations || (judged && gyro_settled);
     if (last) {
-      if (!joint::fillResult(problem, state, built, observability, settings, &ceres_problem,
-                             &result)) {
+      if (!joint::fillResult(problem, state, built, whitening, observability, settings,
+                             &ceres_problem, &result)) {
         return finish(result);
       }
       state.foldRotationIncrements();

@@ -68,8 +68,8 @@ double chiSquareUpperTail(double chi2, int dof) {
 }
 
 bool fillResult(const JointProblem& problem, const State& state, const BuiltProblem& built,
-                const JointObservability& observability, const JointSettings& settings,
-                ceres::Problem* ceres_problem, JointResult* result) {
+                const Whitening& whitening, const JointObservability& observability,
+                const JointSettings& settings, ceres::Problem* ceres_problem, JointResult* result) {
   // Consistency: plain squared whitened residuals (no robust loss).
   const size_t n = problem.poses.size();
   std::vector<double> pose_sum(n, 0.0), pose_count(n, 0.0);
@@ -94,13 +94,9 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
     if (record.magnetometer && record.pose >= 0) result->mag_residual_chi2[record.pose] = squared;
     if (record.camera_link >= 0) {
       result->camera_link_chi2[record.camera_link] = squared;
-      // Unwhitened: the residual is L^-1 Log(R_measured^T R_fit).
-      Eigen::Matrix3d whitening;
-      if (whiteningMatrix(problem.camera_links[record.camera_link].cov_rad2,
-                          settings.camera_sigma_floor_rad, &whitening)) {
-        result->camera_link_residual_rad[record.camera_link] =
-            whitening.lu().solve(Eigen::Vector3d(r.head<3>()));
-      }
+      // Unwhitened: the residual is L^-1 Log(R_measured^T R_fit), L^-1 the link's whitening.
+      result->camera_link_residual_rad[record.camera_link] =
+          whitening.camera_link[record.camera_link].lu().solve(Eigen::Vector3d(r.head<3>()));
     }
     residual_count += record.size;
     if (record.pose < 0) continue;

@@ -139,8 +139,8 @@ BuiltProblem buildProblem(const JointProblem& problem, const std::vector<GyroPre
 /// Covariances, chi2, per-pose norms, intrinsics and the parameter list into `result` (R_cam_imu
 /// and notes are set by the caller). False (with result->message) when the covariance fails.
 bool fillResult(const JointProblem& problem, const State& state, const BuiltProblem& built,
-                const JointObservability& observability, const JointSettings& settings,
-                ceres::Problem* ceres_problem, JointResult* result);
+                const Whitening& whitening, const JointObservability& observability,
+                const JointSettings& settings, ceres::Problem* ceres_problem, JointResult* result);
 
 /// Upper tail P(X > chi2) of a chi-square distribution with dof degrees of freedom (1 for dof <=
 /// 0).

@@ -125,16 +125,16 @@ std::string CalibrationPipeline::Impl::assessScene(const StationarySegment& segm
     link.to_pose = pose->index;
     link.R_from_to = rotation.R_from_to;
     link.cov_rad2 = rotation.cov_rad2;
+    SceneLinkSummary summary{it->pose_index,           rotation.matches,
+                             rotation.inliers,         rotation.model,
+                             rotation.residual_rms_px, rmsSigmaDeg(rotation.cov_rad2),
+                             rotation.R_from_to};
     for (const SceneRotationAlternative& a : rotation.alternatives) {
       link.alternatives.push_back({a.R_from_to, a.cov_rad2});
+      summary.alternatives.push_back(a.R_from_to);
     }
     entry->camera_links.push_back(link);
-    pose->scene_links.push_back({it->pose_index, rotation.matches, rotation.inliers, rotation.model,
-                                 rotation.residual_rms_px, rmsSigmaDeg(rotation.cov_rad2),
-                                 rotation.R_from_to});
-    for (const SceneRotationAlternative& a : rotation.alternatives) {
-      pose->scene_links.back().alternatives.push_back(a.R_from_to);
-    }
+    pose->scene_links.push_back(std::move(summary));
     if (!anchor || rotation.inliers > anchor_rotation.inliers) {
       anchor = &*it;
       anchor_rotation = rotation;

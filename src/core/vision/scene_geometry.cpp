@@ -428,6 +428,11 @@ std::vector<ModelFit> planarAlternatives(const BearingMatches& m, const ModelFit
   std::vector<cv::Mat> rotations, translations, normals;
   cv::decomposeHomographyMat(H, cv::Mat::eye(3, 3, CV_64F), rotations, translations, normals);
   std::vector<Matrix3d> kept = {fit.R_from_to};
+  const auto nearKept = [&](const Matrix3d& R) {
+    return std::any_of(kept.begin(), kept.end(), [&](const Matrix3d& other) {
+      return rotationAngle(other.transpose() * R) < min_separation_rad;
+    });
+  };
   for (size_t k = 0; k < rotations.size(); ++k) {
     Matrix3d R;
     Vector3d t;
@@ -437,16 +442,9 @@ std::vector<ModelFit> planarAlternatives(const BearingMatches& m, const ModelFit
     }
     R = projectToSO3(R);
     if (!R.allFinite() || !(t.norm() > 1e-9)) continue;
-    const auto near = [&](const Matrix3d& other) {
-      return rotationAngle(other.transpose() * R) < min_separation_rad;
-    };
-    if (std::any_of(kept.begin(), kept.end(), near)) continue;
+    if (nearKept(R)) continue;  // refining it would only find a kept solution again
     ModelFit alternative = fitGeneralFrom(m, threshold_px, R, t);
-    if (!alternative.found) continue;
-    const auto near_refined = [&](const Matrix3d& other) {
-      return rotationAngle(other.transpose() * alternative.R_from_to) < min_separation_rad;
-    };
-    if (std::any_of(kept.begin(), kept.end(), near_refined)) continue;
+    if (!alternative.found || nearKept(alternative.R_from_to)) continue;
     kept.push_back(alternative.R_from_to);
     out.push_back(std::move(alternative));
   }
