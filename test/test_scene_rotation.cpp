@@ -191,6 +191,53 @@ TEST(SceneRotation, ANearPlanarViewKeepsItsOtherSolution) {
   EXPECT_GE(with_alternatives, wrong_chosen);
 }
 
+// A robot's pair with an object slid between the views: 200 points of the room seen from places
+// 0.5-1 m apart, turned 10-30 deg, and 100 points (a third) on an object 2-5 m away that slid
+// 2-6 cm between the views (the same rotation, another translation: its points move up to 1.5
+// deg, a few pixels, off the room's epipolar lines, less where the slide runs along them). With
+// the rotation held 0.1 deg off the truth (the gyro's consensus is about that good) while the
+// inliers are chosen, the rotation found is within its 3 sigma of the truth far more often than
+// the free fit's. Measured (2026-11-27): held 17 of 20 within 3 sigma, free 10; the held fits
+// keep the object's matches that lie within the gate of the room's motion (199-299 inliers).
+TEST(SceneRotation, TwoMotionsSharingTheRotationAreNotAveragedWithTheRotationHeld) {
+  const CameraIntrinsics intrinsics = syntheticIntrinsics();
+  int held_within = 0, free_within = 0;
+  constexpr int kSeeds = 20;
+  for (int seed = 0; seed < kSeeds; ++seed) {
+    std::mt19937_64 rng(9100 + seed);
+    std::uniform_real_distribution<double> u(0, 1);
+    const Eigen::Matrix3d R_from_to =
+        test::axisAngle(test::randomUnitVector(rng), (10 + 20 * u(rng)) * M_PI / 180);
+    const Eigen::Vector3d t_from = (0.5 + 0.5 * u(rng)) * test::randomUnitVector(rng);
+    const Eigen::Vector3d slide = (0.02 + 0.04 * u(rng)) * test::randomUnitVector(rng);
+    AnalyticViews v = analyticViews(rng, R_from_to, t_from, 0.0, 200);
+    const AnalyticViews moved = analyticViews(rng, R_from_to, t_from + slide, 0.0, 100);
+    v.from.descriptors.push_back(moved.from.descriptors);
+    v.to.descriptors.push_back(moved.to.descriptors);
+    v.from.bearings.insert(v.from.bearings.end(), moved.from.bearings.begin(),
+                           moved.from.bearings.end());
+    v.to.bearings.insert(v.to.bearings.end(), moved.to.bearings.begin(), moved.to.bearings.end());
+    const Eigen::Matrix3d R_near = R_from_to * expSO3(test::randomUnitVector(rng) * deg2rad(0.1));
+    const SceneRotation held =
+        estimateSceneRotationNear(v.from, v.to, intrinsics, R_near, 1.5, SceneRotationSettings());
+    const SceneRotation free =
+        estimateSceneRotation(v.from, v.to, intrinsics, std::nullopt, SceneRotationSettings());
+    ASSERT_TRUE(held.ok) << "seed " << seed << ": " << held.message;
+    EXPECT_NE(held.message.find("held near the prediction"), std::string::npos) << held.message;
+    held_within += normalisedError(held, R_from_to) < kChi2Of3Sigma;
+    free_within += free.ok && normalisedError(free, R_from_to) < kChi2Of3Sigma;
+    if (std::getenv("CIA_VERBOSE")) {
+      std::printf("seed %d: held %.3f deg (nees %.1f, %d inliers), free %.3f deg (nees %.1f)\n",
+                  seed, errorDeg(held, R_from_to), normalisedError(held, R_from_to), held.inliers,
+                  errorDeg(free, R_from_to), normalisedError(free, R_from_to));
+    }
+  }
+  std::printf("%d pairs with a slid object: within 3 sigma held %d, free %d\n", kSeeds, held_within,
+              free_within);
+  EXPECT_GE(held_within, 16);
+  EXPECT_GE(held_within, free_within + 4);
+}
+
 // Known limitation, measured, not asserted (run with --gtest_also_run_disabled_tests): baselines of
 // 0.5-10 cm at 2-5 m depth. There a translation shifts every point by about |t| / depth, which the
 // rotation-only model takes for a rotation and GRIC cannot tell apart until the depth spread makes

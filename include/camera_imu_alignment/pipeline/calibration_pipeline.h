@@ -203,11 +203,23 @@ struct WindowSnapshot {
   /// The natural-scene links' solutions as the gyro's consensus chose them
   /// (estimation/camera_link_consensus.h; joint.camera_links hold the chosen ones).
   CameraLinkConsensus link_consensus;
+  /// Natural scene: fits camera link `link` (index into joint.camera_links) again from its two
+  /// views with the rotation held near `R_from_to_near` while the inliers are chosen
+  /// (estimateSceneRotationNear); nullopt when its views are no longer held. Empty without a
+  /// natural scene. Thread-safe (shares the views' features, read-only, and a locked cache).
+  std::function<std::optional<SceneRotation>(int link, const Eigen::Matrix3d& R_from_to_near)>
+      scene_link_refit;
 };
 
 /// The solve of a window: the pair estimators, then (imu_orientation: joint or
 /// magnetometer) the joint estimate started from the pair estimate. Pure: no pipeline state.
-AlignmentResult solveWindow(const WindowSnapshot& window, const PipelineSettings& settings);
+/// `as_measured` (optional): the joint solve of window.joint itself, before any natural-scene link
+/// was fitted again (JointResult::camera_links_refitted; the same as the result's when none was),
+/// for the mount-change test, which compares its models on the links as measured (links fitted
+/// again near a one-mount estimate, at their tighter noise, made it see a 0.19 deg remount on an
+/// unchanged hand-held recording).
+AlignmentResult solveWindow(const WindowSnapshot& window, const PipelineSettings& settings,
+                            JointResult* as_measured = nullptr);
 
 struct PipelineCallbacks {
   std::function<void(const StationaryPose&)> on_pose;

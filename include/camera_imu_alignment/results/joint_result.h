@@ -130,6 +130,14 @@ struct JointResult {
   /// as a rotation vector (rad, camera axes); zero for a pose without an absolute camera
   /// orientation (the natural scene). Motion nodes': MotionFigures::node_camera_residual_rad.
   std::vector<Eigen::Vector3d> camera_residual_rad;
+  /// Per pose: the camera's orientation at the estimate, R_target_cam Exp(correction) (target or
+  /// natural-scene frame; the measured one where the camera's correction was not estimated):
+  /// (fit_from)^T fit_to is the estimate's rotation of a camera link, left out or not.
+  std::vector<Eigen::Matrix3d> camera_orientation_fit;
+  /// Camera links (indices into JointProblem::camera_links) whose rotation the pipeline fitted
+  /// again from the views with the rotation held near this estimate's (natural scene: a moved
+  /// object in view; pipeline/calibration_pipeline.h, WindowSnapshot::scene_link_refit). Sorted.
+  std::vector<int> camera_links_refitted;
   /// Isotropic variance added to every rest's camera covariance (rad^2 per axis) because the
   /// rests' camera residuals exceeded their covariances (JointSettings::camera_excess_level): the
   /// camera's noise as the recording shows it. 0 when not.

@@ -114,4 +114,17 @@ SceneRotation estimateSceneRotation(const SceneFeatures& from, const SceneFeatur
                                     const std::optional<Eigen::Matrix3d>& R_from_to_prediction,
                                     const SceneRotationSettings& settings);
 
+/// The rotation between two views with the rotation held near `R_from_to_near` while each model's
+/// inliers are chosen (within `gate_px`, at most SceneRotationSettings::ransac_threshold_px), then
+/// refined freely and chosen by GRIC: for a pair whose free fit the IMU contradicts. Two motions in
+/// view that share the rotation (the room, and an object moved between the views) make a free fit
+/// at a loose gate average them into a compromise; with the rotation held, the translation found
+/// holds one of them, and either gives the camera's rotation. The gate must cover the prediction's
+/// error (pixels: focal length times its angle) and the image noise. Results as
+/// estimateSceneRotation (no alternatives; no prediction check).
+SceneRotation estimateSceneRotationNear(const SceneFeatures& from, const SceneFeatures& to,
+                                        const CameraIntrinsics& intrinsics,
+                                        const Eigen::Matrix3d& R_from_to_near, double gate_px,
+                                        const SceneRotationSettings& settings);
+
 }  // namespace camera_imu_alignment

@@ -80,7 +80,11 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
   result->camera_link_chi2.assign(problem.camera_links.size(), 0.0);
   result->camera_link_residual_rad.assign(problem.camera_links.size(), Eigen::Vector3d::Zero());
   result->camera_residual_rad.assign(n, Eigen::Vector3d::Zero());
+  result->camera_orientation_fit.assign(n, Eigen::Matrix3d::Identity());
   for (size_t k = 0; k < n; ++k) {
+    result->camera_orientation_fit[k] =
+        projectToSO3(problem.poses[k].R_target_cam) *
+        expSO3(Eigen::Map<const Eigen::Vector3d>(state.delta[k].data()));
     if (problem.poses[k].camera_absolute) {  // a rest's PnP or a motion node's
       result->camera_residual_rad[k] = Eigen::Map<const Eigen::Vector3d>(state.delta[k].data());
     }

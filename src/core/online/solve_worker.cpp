@@ -10,8 +10,9 @@ SolveOutput runSolveJob(SolveJob job, const PipelineSettings& pipeline,
                         const OnlineSettings& online) {
   SolveOutput out;
   out.inputs = job.inputs;
-  out.result = solveWindow(job.window, pipeline);
-  if (job.test_mount_change && out.result.joint && out.result.joint->ok) {
+  JointResult as_measured;  // before any natural-scene link was fitted again
+  out.result = solveWindow(job.window, pipeline, &as_measured);
+  if (job.test_mount_change && out.result.joint && out.result.joint->ok && as_measured.ok) {
     // A split whose first pose was never a candidate of a test (its windows were skipped) is
     // one: the splits with fewer than min_poses_after poses after them in the last tested window
     // were only pending, so the reach is the untested poses plus min_poses_after - 1.
@@ -19,7 +20,7 @@ SolveOutput runSolveJob(SolveJob job, const PipelineSettings& pipeline,
     remount.max_poses_after =
         std::max(remount.max_poses_after, job.poses_not_yet_tested + remount.min_poses_after - 1);
     out.mount_test =
-        testMountChange(job.window.joint, *out.result.joint, jointSettingsOf(pipeline), remount);
+        testMountChange(job.window.joint, as_measured, jointSettingsOf(pipeline), remount);
   }
   out.window = std::move(job.window);
   return out;

@@ -4,6 +4,9 @@
 
 #include <deque>
 #include <limits>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -136,9 +139,20 @@ struct CalibrationPipeline::Impl {
     int pose_index = 0, scene = 0, group = 0;
     Eigen::Matrix3d R_scene_cam = Eigen::Matrix3d::Identity();
     Eigen::Matrix3d R_world_imu = Eigen::Matrix3d::Identity();  ///< the pose's (gyro chain)
-    SceneFeatures features;
+    std::shared_ptr<const SceneFeatures> features;  ///< shared with the snapshots' refits
   };
   std::deque<SceneView> scene_views;
+  /// Links fitted again with the rotation held (WindowSnapshot::scene_link_refit), by their poses'
+  /// StationaryPose::index: a later solve with nearly the same prediction reuses the fit.
+  struct SceneRefitCache {
+    struct Entry {
+      Eigen::Matrix3d R_from_to_near = Eigen::Matrix3d::Identity();
+      SceneRotation rotation;
+    };
+    std::mutex mutex;
+    std::map<std::pair<int, int>, Entry> entries;
+  };
+  std::shared_ptr<SceneRefitCache> scene_refit_cache = std::make_shared<SceneRefitCache>();
   int scenes_started = 0;
   std::uint64_t rotations_refused_by_imu = 0;  ///< scene rotations the IMU's angle contradicts
 
@@ -181,6 +195,10 @@ struct CalibrationPipeline::Impl {
   /// joint_gyro_pending by the gyro samples since the previous rest.
   StationaryWindow::Entry jointMeasurements(const StationarySegment& segment,
                                             const StationaryPose& pose, const SegmentField& field);
+  /// Natural scene: WindowSnapshot::scene_link_refit for `problem`'s links (pose indices local to
+  /// the window, `pose_indices` their StationaryPose::index); empty without a natural scene.
+  std::function<std::optional<SceneRotation>(int, const Eigen::Matrix3d&)> sceneLinkRefit(
+      const JointProblem& problem, const std::vector<int>& pose_indices) const;
   WindowSnapshot snapshot() const;
 };
 

@@ -368,6 +368,7 @@ WindowSnapshot CalibrationPipeline::Impl::snapshot() const {
   for (const StationaryPose& pose : window.poses()) out.pose_indices.push_back(pose.index);
   // A near-planar view's two solutions: the one the gyro agrees with.
   if (!out.joint.camera_links.empty()) out.link_consensus = chooseCameraLinkSolutions(&out.joint);
+  out.scene_link_refit = sceneLinkRefit(out.joint, out.pose_indices);
   return out;
 }
 
@@ -389,9 +390,46 @@ std::string otherSolutions(const WindowSnapshot& window, const JointResult& join
   return s.str();
 }
 
+/// The natural scene's links fitted again from their views with the rotation held near the joint
+/// estimate's (WindowSnapshot::scene_link_refit), and the estimate solved again with them. Two
+/// motions in view that share the rotation (the room and an object moved between the rests) pull
+/// a free two-view fit into a compromise between them, a few tenths of a degree off; held, the
+/// fit follows one of them. A link whose views are gone or whose held fit fails keeps its rotation.
+/// The links taken replace window->joint's.
+JointResult withSceneLinksRefitted(const JointEstimator& estimator, WindowSnapshot* window,
+                                   JointResult joint) {
+  const JointProblem& problem = window->joint;
+  if (!joint.ok || !window->scene_link_refit ||
+      joint.camera_orientation_fit.size() != problem.poses.size()) {
+    return joint;
+  }
+  JointProblem refitted = problem;
+  std::vector<int> changed;
+  for (std::size_t j = 0; j < refitted.camera_links.size(); ++j) {
+    CameraLink& link = refitted.camera_links[j];
+    const Eigen::Matrix3d R_fit =
+        joint.camera_orientation_fit[static_cast<std::size_t>(link.from_pose)].transpose() *
+        joint.camera_orientation_fit[static_cast<std::size_t>(link.to_pose)];
+    const std::optional<SceneRotation> again = window->scene_link_refit(static_cast<int>(j), R_fit);
+    if (!again || !again->ok || rotationAngle(again->R_from_to.transpose() * link.R_from_to) == 0)
+      continue;
+    link.alternatives.push_back({link.R_from_to, link.cov_rad2});
+    link.R_from_to = again->R_from_to;
+    link.cov_rad2 = again->cov_rad2;
+    changed.push_back(static_cast<int>(j));
+  }
+  if (changed.empty()) return joint;
+  JointResult second = solveScreeningCameraLinks(estimator, refitted, joint.R_cam_imu);
+  if (!second.ok) return joint;
+  second.camera_links_refitted = std::move(changed);
+  window->joint = std::move(refitted);
+  return second;
+}
+
 }  // namespace
 
-AlignmentResult solveWindow(const WindowSnapshot& window_in, const PipelineSettings& settings) {
+AlignmentResult solveWindow(const WindowSnapshot& window_in, const PipelineSettings& settings,
+                            JointResult* as_measured) {
   WindowSnapshot window = window_in;
   std::string motion_note;
   MotionFigures motion_figures;
@@ -415,8 +453,10 @@ AlignmentResult solveWindow(const WindowSnapshot& window_in, const PipelineSetti
   }
   // The joint estimate, started from the pair solve.
   // Natural-scene rotations screened: a wrong one is left out (camera_link_screening.h).
-  const JointResult joint = solveScreeningCameraLinks(JointEstimator(jointSettingsOf(settings)),
-                                                      window.joint, result.R_cam_imu);
+  const JointEstimator estimator(jointSettingsOf(settings));
+  JointResult measured = solveScreeningCameraLinks(estimator, window.joint, result.R_cam_imu);
+  const JointResult joint = withSceneLinksRefitted(estimator, &window, measured);
+  if (as_measured) *as_measured = std::move(measured);
   const std::size_t links_dropped = joint.camera_links_left_out.size();
   const std::string sensors = settings.imu_orientation == ImuOrientationSource::kMagnetometer
                                   ? " (camera, accelerometer, magnetometer; gyro not used)"
@@ -436,6 +476,10 @@ AlignmentResult solveWindow(const WindowSnapshot& window_in, const PipelineSetti
             ? ""
             : ", " + std::to_string(window.joint.camera_links.size() - links_dropped) +
                   " natural-scene rotations" + otherSolutions(window, joint) +
+                  (joint.camera_links_refitted.empty()
+                       ? ""
+                       : " (" + std::to_string(joint.camera_links_refitted.size()) +
+                             " fitted again with the rotation held near the estimate's)") +
                   (links_dropped > 0 ? " (" + std::to_string(links_dropped) +
                                            " more left out: residual beyond chi-square(3) "
                                            "p 1e-4)"

@@ -23,6 +23,12 @@ constexpr std::size_t kMaxSceneCandidates = 64;
 /// ambiguity on a near-planar view) and is not used.
 constexpr double kAngleCheckFloorDeg = 0.2;
 constexpr double kAngleCheckSigmas = 4.0;
+/// A link fitted again with the rotation held near the estimate's (sceneLinkRefit): the inliers'
+/// gate (pixels). About 3 of the images' noise; the estimate's prediction of a link is good to
+/// about a pixel (0.1 deg at 500 px).
+constexpr double kHeldRotationGatePx = 1.5;
+/// A cached refit serves while the prediction stays within this share of the gate.
+constexpr double kRefitReuseShare = 0.5;
 
 double rmsSigmaDeg(const Eigen::Matrix3d& cov_rad2) {
   return rad2deg(std::sqrt(std::max(0.0, cov_rad2.trace()) / 3.0));
@@ -94,7 +100,7 @@ std::string CalibrationPipeline::Impl::assessScene(const StationarySegment& segm
       prediction = *R_cam_imu_guess * it->R_world_imu.transpose() * pose->R_world_imu *
                    R_cam_imu_guess->transpose();
     }
-    SceneRotation rotation = estimateSceneRotation(it->features, features, *intrinsics, prediction,
+    SceneRotation rotation = estimateSceneRotation(*it->features, features, *intrinsics, prediction,
                                                    settings.scene_rotation);
     if (rotation.ok && it->group == pose->group) {
       const double imu_deg =
@@ -159,9 +165,57 @@ std::string CalibrationPipeline::Impl::assessScene(const StationarySegment& segm
   pose->camera_spread_deg = 0.0;
   entry->joint.camera_absolute = false;
   scene_views.push_back({pose->index, pose->scene, pose->group, pose->R_target_cam,
-                         pose->R_world_imu, std::move(features)});
+                         pose->R_world_imu,
+                         std::make_shared<const SceneFeatures>(std::move(features))});
   while (scene_views.size() > settings.window_poses + 1) scene_views.pop_front();
+  {  // The refits of links whose first view is gone are not asked for again.
+    const std::lock_guard<std::mutex> lock(scene_refit_cache->mutex);
+    auto& entries = scene_refit_cache->entries;
+    while (!entries.empty() && entries.begin()->first.first < scene_views.front().pose_index) {
+      entries.erase(entries.begin());
+    }
+  }
   return "";
+}
+
+std::function<std::optional<SceneRotation>(int, const Eigen::Matrix3d&)>
+CalibrationPipeline::Impl::sceneLinkRefit(const JointProblem& problem,
+                                          const std::vector<int>& pose_indices) const {
+  if (!natural_scene || !intrinsics || problem.camera_links.empty()) return {};
+  std::map<int, std::shared_ptr<const SceneFeatures>> views;
+  for (const SceneView& v : scene_views) views[v.pose_index] = v.features;
+  std::vector<std::pair<int, int>> link_poses;  // StationaryPose::index of each link's views
+  const auto global = [&](int local) {
+    return local >= 0 && local < static_cast<int>(pose_indices.size())
+               ? pose_indices[static_cast<std::size_t>(local)]
+               : -1;
+  };
+  for (const CameraLink& link : problem.camera_links) {
+    link_poses.emplace_back(global(link.from_pose), global(link.to_pose));
+  }
+  const double focal = std::sqrt(intrinsics->K(0, 0) * intrinsics->K(1, 1));
+  const double reuse_rad = kRefitReuseShare * kHeldRotationGatePx / focal;
+  return [views = std::move(views), link_poses = std::move(link_poses), intrinsics = *intrinsics,
+          scene_settings = settings.scene_rotation, cache = scene_refit_cache,
+          reuse_rad](int link, const Eigen::Matrix3d& R_near) -> std::optional<SceneRotation> {
+    if (link < 0 || link >= static_cast<int>(link_poses.size())) return std::nullopt;
+    const std::pair<int, int> key = link_poses[static_cast<std::size_t>(link)];
+    const auto from = views.find(key.first), to = views.find(key.second);
+    if (from == views.end() || to == views.end()) return std::nullopt;
+    {
+      const std::lock_guard<std::mutex> lock(cache->mutex);
+      const auto hit = cache->entries.find(key);
+      if (hit != cache->entries.end() &&
+          rotationAngle(hit->second.R_from_to_near.transpose() * R_near) < reuse_rad) {
+        return hit->second.rotation;
+      }
+    }
+    SceneRotation again = estimateSceneRotationNear(*from->second, *to->second, intrinsics, R_near,
+                                                    kHeldRotationGatePx, scene_settings);
+    const std::lock_guard<std::mutex> lock(cache->mutex);
+    cache->entries[key] = {R_near, again};
+    return again;
+  };
 }
 
 }  // namespace camera_imu_alignment

@@ -29,6 +29,8 @@ constexpr double kMinSigmaPx = 1e-3;  // noise-free data: keep the covariance in
 constexpr int kRansacMaxIterations = 1000;
 constexpr double kRansacConfidence = 0.999;
 constexpr int kRefinementRounds = 4;
+/// Translation hypotheses (pairs of matches) with the rotation held.
+constexpr int kHeldRotationIterations = 500;
 constexpr double kLeverageGate = 0.2;  // a match's leverage (hat-matrix trace) to be cross-checked
 /// Triangulated depths (in baselines) up to which cheirality is judged in recoverPose.
 constexpr double kCheiralityMaxDepth = 1e6;
@@ -408,6 +410,60 @@ ModelFit fitGeneralFrom(const BearingMatches& m, double threshold_px, const Matr
   s.R = projectToSO3(R_from_to);
   s.t = t_from.normalized();
   return refineAndSelect(m, s, threshold_px, true, true);
+}
+
+HeldRotationFits fitNearRotation(const BearingMatches& m, const Matrix3d& R_from_to,
+                                 double gate_px) {
+  HeldRotationFits out;
+  const int n = static_cast<int>(m.from.size());
+  if (n < 6 || !(gate_px > 0)) return out;
+  State held;
+  held.R = projectToSO3(R_from_to);
+  out.rotation = refineAndSelect(m, held, gate_px, false, true);
+  // t . (R to x from) = 0 for every match of a motion (R, t): two matches' normals give t.
+  const double focal = std::sqrt(m.fx * m.fy);
+  const double gate2 = gate_px * gate_px;
+  std::vector<Vector3d> normals(n);
+  for (int i = 0; i < n; ++i) normals[i] = (held.R * m.to[i]).cross(m.from[i]);
+  const auto score = [&](const Vector3d& t) {
+    const Matrix3d E = skew(t) * held.R;
+    double sum = 0;
+    for (int i = 0; i < n; ++i)
+      sum += std::min(std::pow(sampsonResidual(E, m.from[i], m.to[i], m.fx, m.fy), 2), gate2);
+    return sum;
+  };
+  // A match whose normal is within the gate of zero says nothing of t (no parallax).
+  const double min_normal = gate_px / focal;
+  std::mt19937 rng(20261127);  // deterministic: the same views give the same rotation
+  std::uniform_int_distribution<int> pick(0, n - 1);
+  double best = std::numeric_limits<double>::infinity();
+  Vector3d t_best = Vector3d::Zero();
+  for (int iteration = 0; iteration < kHeldRotationIterations; ++iteration) {
+    const int i = pick(rng), j = pick(rng);
+    if (i == j || normals[i].norm() < min_normal || normals[j].norm() < min_normal) continue;
+    const Vector3d t = normals[i].cross(normals[j]);
+    if (t.norm() < 1e-3 * normals[i].norm() * normals[j].norm()) continue;
+    const double cost = score(t.normalized());
+    if (cost < best) {
+      best = cost;
+      t_best = t.normalized();
+    }
+  }
+  if (!(t_best.norm() > 0)) return out;
+  // The sign: more of the matches within the gate in front of both cameras.
+  State general = held;
+  const Matrix3d E = skew(t_best) * held.R;
+  int front = 0, behind = 0;
+  for (int i = 0; i < n; ++i) {
+    if (std::pow(sampsonResidual(E, m.from[i], m.to[i], m.fx, m.fy), 2) >= gate2) continue;
+    general.t = t_best;
+    front += inFrontOfBoth(general, m.from[i], m.to[i]);
+    general.t = -t_best;
+    behind += inFrontOfBoth(general, m.from[i], m.to[i]);
+  }
+  general.t = front >= behind ? t_best : Vector3d(-t_best);
+  out.general = refineAndSelect(m, general, gate_px, true, true);
+  return out;
 }
 
 std::vector<ModelFit> planarAlternatives(const BearingMatches& m, const ModelFit& fit,

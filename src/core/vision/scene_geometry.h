@@ -58,6 +58,21 @@ ModelFit fitGeneral(const BearingMatches& matches, double threshold_px, bool scr
 ModelFit fitGeneralFrom(const BearingMatches& matches, double threshold_px,
                         const Eigen::Matrix3d& R_from_to, const Eigen::Vector3d& t_from);
 
+/// Both models with the rotation held at a given one while their inliers are chosen (e.g. the
+/// gyro's consensus, good to a few tenths of a degree): the rotation-only model from the matches
+/// within `gate_px` of R_from_to's transfer; the general model's translation direction by RANSAC
+/// over pairs of matches with R_from_to held (two epipolar planes' normals cross in it; scored by
+/// the squared Sampson distance truncated at `gate_px`; its sign by cheirality). Each is then
+/// refined (rotation free) at `gate_px`, with the screens. Two motions in view that share the
+/// rotation (the room, and an object slid between the views: another translation) are then not
+/// averaged into one compromise, as a free 5-point RANSAC at a loose gate can: the translation
+/// found holds one of them.
+struct HeldRotationFits {
+  ModelFit rotation, general;
+};
+HeldRotationFits fitNearRotation(const BearingMatches& matches, const Eigen::Matrix3d& R_from_to,
+                                 double gate_px);
+
 /// The other general-model solutions a near-planar view allows: a homography fitted to the
 /// matches `fit` holds (inliers), decomposed (up to four rotations with their translation and
 /// plane), each refined over all matches like fitGeneralFrom. Solutions within `min_separation_rad`

@@ -81,6 +81,81 @@ std::string counts(const SceneFeatures& from, const SceneFeatures& to) {
   return s.str();
 }
 
+/// The views' matches as bearings (result->matches and the counts in `why`); false with
+/// result->message set when the intrinsics, the features or the matches do not allow a fit.
+bool matchViews(const SceneFeatures& from, const SceneFeatures& to,
+                const CameraIntrinsics& intrinsics, const SceneRotationSettings& settings,
+                SceneRotation* result, scene_geometry::BearingMatches* matches,
+                std::ostringstream* why) {
+  const std::string intrinsics_error = intrinsics.validate();
+  if (!intrinsics_error.empty()) {
+    result->message = "camera intrinsics unusable: " + intrinsics_error;
+    return false;
+  }
+  if (from.descriptors.rows != static_cast<int>(from.bearings.size()) ||
+      to.descriptors.rows != static_cast<int>(to.bearings.size())) {
+    result->message = "features inconsistent: descriptors and bearings differ in count";
+    return false;
+  }
+  const std::vector<std::pair<int, int>> index_pairs =
+      mutualRatioMatches(from.descriptors, to.descriptors, settings.ratio_test);
+  result->matches = static_cast<int>(index_pairs.size());
+  matches->fx = intrinsics.K(0, 0);
+  matches->fy = intrinsics.K(1, 1);
+  for (const auto& [i, j] : index_pairs) {
+    matches->from.push_back(from.bearings[i]);
+    matches->to.push_back(to.bearings[j]);
+  }
+  *why << counts(from, to) << ", " << result->matches << " matches";
+  if (result->matches < settings.min_inliers) {
+    result->message = "too few matches (" + why->str() + "; min_inliers " +
+                      std::to_string(settings.min_inliers) +
+                      "): too little overlap or texture between the views";
+    return false;
+  }
+  return true;
+}
+
+/// GRIC's choice between the two models over the matches either explains (gross mismatches say
+/// nothing about the model), with the general model's noise as the common sigma: true for the
+/// rotation-only model.
+bool rotationOnlyChosen(const scene_geometry::ModelFit& rotation,
+                        const scene_geometry::ModelFit& general) {
+  if (!rotation.found || !general.found) return rotation.found;
+  std::vector<bool> counted(rotation.inlier.size());
+  for (size_t k = 0; k < counted.size(); ++k) counted[k] = rotation.inlier[k] || general.inlier[k];
+  return scene_geometry::gric(rotation, counted, general.sigma_px, 3) <=
+         scene_geometry::gric(general, counted, general.sigma_px, 5);
+}
+
+/// `fit` (of the model named) as the result, or the reason it is not one.
+void takeFit(const scene_geometry::ModelFit& fit, bool rotation_only,
+             const SceneRotationSettings& settings, SceneRotation* result,
+             std::ostringstream* why) {
+  result->inliers = fit.found ? fit.inliers : 0;
+  *why << ", " << result->inliers << " inliers";
+  if (!fit.found || result->inliers < settings.min_inliers) {
+    result->message = "too few inliers (" + why->str() + "; min_inliers " +
+                      std::to_string(settings.min_inliers) +
+                      "): the views overlap too little, or the matches are wrong (repetitive "
+                      "texture, a scene that moved)";
+    return;
+  }
+  if (!fit.cov_rad2.allFinite() || !fit.R_from_to.allFinite()) {
+    result->message = "degenerate fit (" + why->str() + "): no covariance";
+    return;
+  }
+  result->model = rotation_only ? SceneMotionModel::kRotationOnly : SceneMotionModel::kGeneral;
+  result->R_from_to = fit.R_from_to;
+  result->cov_rad2 = fit.cov_rad2;
+  result->translation_direction = fit.t_from;
+  result->residual_rms_px = fit.sigma_px;
+  *why << ", " << (rotation_only ? "rotation only" : "general motion") << ", " << fit.sigma_px
+       << " px";
+  result->ok = true;
+  result->message = why->str();
+}
+
 }  // namespace
 
 double imageSharpness(const cv::Mat& mono8) {
@@ -149,50 +224,14 @@ SceneRotation estimateSceneRotation(const SceneFeatures& from, const SceneFeatur
                                     const std::optional<Eigen::Matrix3d>& R_from_to_prediction,
                                     const SceneRotationSettings& settings) {
   SceneRotation result;
-  const std::string intrinsics_error = intrinsics.validate();
-  if (!intrinsics_error.empty()) {
-    result.message = "camera intrinsics unusable: " + intrinsics_error;
-    return result;
-  }
-  if (from.descriptors.rows != static_cast<int>(from.bearings.size()) ||
-      to.descriptors.rows != static_cast<int>(to.bearings.size())) {
-    result.message = "features inconsistent: descriptors and bearings differ in count";
-    return result;
-  }
-  const std::vector<std::pair<int, int>> index_pairs =
-      mutualRatioMatches(from.descriptors, to.descriptors, settings.ratio_test);
-  result.matches = static_cast<int>(index_pairs.size());
-  scene_geometry::BearingMatches matches;
-  matches.fx = intrinsics.K(0, 0);
-  matches.fy = intrinsics.K(1, 1);
-  for (const auto& [i, j] : index_pairs) {
-    matches.from.push_back(from.bearings[i]);
-    matches.to.push_back(to.bearings[j]);
-  }
   std::ostringstream why;
-  why << counts(from, to) << ", " << result.matches << " matches";
-  if (result.matches < settings.min_inliers) {
-    result.message = "too few matches (" + why.str() + "; min_inliers " +
-                     std::to_string(settings.min_inliers) +
-                     "): too little overlap or texture between the views";
-    return result;
-  }
-
+  scene_geometry::BearingMatches matches;
+  if (!matchViews(from, to, intrinsics, settings, &result, &matches, &why)) return result;
   const scene_geometry::ModelFit rotation =
       scene_geometry::fitRotationOnly(matches, settings.ransac_threshold_px, R_from_to_prediction);
   scene_geometry::ModelFit general =
       scene_geometry::fitGeneral(matches, settings.ransac_threshold_px, false);
-  // GRIC over the matches that either model explains (gross mismatches say nothing about the
-  // model), with the general model's noise as the common sigma.
-  bool use_rotation = rotation.found;
-  if (rotation.found && general.found) {
-    std::vector<bool> counted(matches.from.size());
-    for (size_t k = 0; k < counted.size(); ++k)
-      counted[k] = rotation.inlier[k] || general.inlier[k];
-    const double sigma_px = general.sigma_px;
-    use_rotation = scene_geometry::gric(rotation, counted, sigma_px, 3) <=
-                   scene_geometry::gric(general, counted, sigma_px, 5);
-  }
+  const bool use_rotation = rotationOnlyChosen(rotation, general);
   if (!use_rotation) {
     general = scene_geometry::fitGeneral(matches, settings.ransac_threshold_px, true);
     // A near-planar view has two essential matrices that explain it about equally well: with a
@@ -211,26 +250,8 @@ SceneRotation estimateSceneRotation(const SceneFeatures& from, const SceneFeatur
     }
   }
   const scene_geometry::ModelFit& fit = use_rotation ? rotation : general;
-  result.inliers = fit.found ? fit.inliers : 0;
-  why << ", " << result.inliers << " inliers";
-  if (!fit.found || result.inliers < settings.min_inliers) {
-    result.message = "too few inliers (" + why.str() + "; min_inliers " +
-                     std::to_string(settings.min_inliers) +
-                     "): the views overlap too little, or the matches are wrong (repetitive "
-                     "texture, a scene that moved)";
-    return result;
-  }
-  if (!fit.cov_rad2.allFinite() || !fit.R_from_to.allFinite()) {
-    result.message = "degenerate fit (" + why.str() + "): no covariance";
-    return result;
-  }
-  result.model = use_rotation ? SceneMotionModel::kRotationOnly : SceneMotionModel::kGeneral;
-  result.R_from_to = fit.R_from_to;
-  result.cov_rad2 = fit.cov_rad2;
-  result.translation_direction = fit.t_from;
-  result.residual_rms_px = fit.sigma_px;
-  why << ", " << (use_rotation ? "rotation only" : "general motion") << ", " << fit.sigma_px
-      << " px";
+  takeFit(fit, use_rotation, settings, &result, &why);
+  if (!result.ok) return result;
   if (R_from_to_prediction && settings.max_prediction_difference_deg > 0) {
     const double difference_deg =
         rotationAngle(R_from_to_prediction->transpose() * fit.R_from_to) * kRadToDeg;
@@ -240,6 +261,7 @@ SceneRotation estimateSceneRotation(const SceneFeatures& from, const SceneFeatur
         << settings.max_prediction_difference_deg
         << " deg; repetitive texture or a wrong prediction): " << why.str();
       result.message = s.str();
+      result.ok = false;
       return result;
     }
   }
@@ -262,6 +284,23 @@ SceneRotation estimateSceneRotation(const SceneFeatures& from, const SceneFeatur
   }
   result.ok = true;
   result.message = why.str();
+  return result;
+}
+
+SceneRotation estimateSceneRotationNear(const SceneFeatures& from, const SceneFeatures& to,
+                                        const CameraIntrinsics& intrinsics,
+                                        const Eigen::Matrix3d& R_from_to_near, double gate_px,
+                                        const SceneRotationSettings& settings) {
+  SceneRotation result;
+  std::ostringstream why;
+  scene_geometry::BearingMatches matches;
+  if (!matchViews(from, to, intrinsics, settings, &result, &matches, &why)) return result;
+  const double gate = std::min(gate_px, settings.ransac_threshold_px);
+  const scene_geometry::HeldRotationFits fits =
+      scene_geometry::fitNearRotation(matches, R_from_to_near, gate);
+  const bool use_rotation = rotationOnlyChosen(fits.rotation, fits.general);
+  why << ", the rotation held near the prediction (gate " << gate << " px)";
+  takeFit(use_rotation ? fits.rotation : fits.general, use_rotation, settings, &result, &why);
   return result;
 }
 
