@@ -104,6 +104,30 @@ BENCHMARK(BM_PairRotation)
     ->Args({1000, 50})
     ->Unit(benchmark::kMillisecond);
 
+// A link fitted again in the solve (estimateSceneRotationNear: the rotation held at the truth,
+// 1.5 px gate) from the matches of its first fit, as the pipeline does; arg 0: matched again.
+void BM_PairRotationHeld(benchmark::State& state) {
+  const cia::SceneFeatureSettings settings;
+  const cia::CameraIntrinsics camera = intrinsics();
+  const cia::SceneFeatures from = cia::extractSceneFeatures(views().first, camera, settings, 0);
+  const cia::SceneFeatures to = cia::extractSceneFeatures(views().second, camera, settings, 1);
+  const cia::SceneRotation first =
+      cia::estimateSceneRotation(from, to, camera, std::nullopt, cia::SceneRotationSettings());
+  const bool reuse = state.range(0) != 0;
+  cia::SceneRotation r;
+  for (auto _ : state) {
+    r = cia::estimateSceneRotationNear(from, to, camera, views().R_from_to, 1.5,
+                                       cia::SceneRotationSettings(),
+                                       reuse ? &first.matched : nullptr);
+    benchmark::DoNotOptimize(r.R_from_to.data());
+  }
+  if (!r.ok) state.SkipWithError(r.message.c_str());
+  state.counters["inliers"] = r.inliers;
+  state.counters["error_mdeg"] =
+      1e3 * 180 / M_PI * Eigen::AngleAxisd(r.R_from_to.transpose() * views().R_from_to).angle();
+}
+BENCHMARK(BM_PairRotationHeld)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
+
 }  // namespace
 
 int main(int argc, char** argv) {

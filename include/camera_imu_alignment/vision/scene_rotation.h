@@ -15,6 +15,7 @@
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "camera_imu_alignment/vision/camera_model.h"
@@ -74,6 +75,9 @@ struct SceneRotationSettings {
   double alternative_inlier_share = 0.9;
 };
 
+/// Matches between two views' features: (index into `from`, index into `to`).
+using SceneMatchIndices = std::vector<std::pair<int, int>>;
+
 /// Another rotation that explains the matches about as well as the chosen one (a near-planar
 /// view's second essential matrix): the joint estimate may take it instead when the IMU says so.
 struct SceneRotationAlternative {
@@ -100,6 +104,9 @@ struct SceneRotation {
   /// Other solutions holding at least SceneRotationSettings::alternative_inlier_share of the
   /// chosen model's inliers, more than 3 of its sigmas away from it.
   std::vector<SceneRotationAlternative> alternatives;
+  /// The matches the fit started from (ratio test and mutual check), to fit the pair again
+  /// without matching (estimateSceneRotationNear).
+  SceneMatchIndices matched;
 };
 
 /// The rotation between two views. `R_from_to_prediction` (e.g. the gyro's, through the current
@@ -121,10 +128,12 @@ SceneRotation estimateSceneRotation(const SceneFeatures& from, const SceneFeatur
 /// at a loose gate average them into a compromise; with the rotation held, the translation found
 /// holds one of them, and either gives the camera's rotation. The gate must cover the prediction's
 /// error (pixels: focal length times its angle) and the image noise. Results as
-/// estimateSceneRotation (no alternatives; no prediction check).
+/// estimateSceneRotation (no alternatives; no prediction check). `matched` (optional): the pair's
+/// matches from an earlier fit (SceneRotation::matched), which saves matching them again.
 SceneRotation estimateSceneRotationNear(const SceneFeatures& from, const SceneFeatures& to,
                                         const CameraIntrinsics& intrinsics,
                                         const Eigen::Matrix3d& R_from_to_near, double gate_px,
-                                        const SceneRotationSettings& settings);
+                                        const SceneRotationSettings& settings,
+                                        const SceneMatchIndices* matched = nullptr);
 
 }  // namespace camera_imu_alignment

@@ -140,6 +140,8 @@ std::string CalibrationPipeline::Impl::assessScene(const StationarySegment& segm
       summary.alternatives.push_back(a.R_from_to);
     }
     entry->camera_links.push_back(link);
+    scene_link_matches[{it->pose_index, pose->index}] =
+        std::make_shared<const SceneMatchIndices>(rotation.matched);
     pose->scene_links.push_back(std::move(summary));
     if (!anchor || rotation.inliers > anchor_rotation.inliers) {
       anchor = &*it;
@@ -168,12 +170,17 @@ std::string CalibrationPipeline::Impl::assessScene(const StationarySegment& segm
                          pose->R_world_imu,
                          std::make_shared<const SceneFeatures>(std::move(features))});
   while (scene_views.size() > settings.window_poses + 1) scene_views.pop_front();
-  {  // The refits of links whose first view is gone are not asked for again.
+  // The matches and refits of links whose first view is gone are not asked for again.
+  const auto gone = [&](const std::pair<int, int>& key) {
+    return key.first < scene_views.front().pose_index;
+  };
+  while (!scene_link_matches.empty() && gone(scene_link_matches.begin()->first)) {
+    scene_link_matches.erase(scene_link_matches.begin());
+  }
+  {
     const std::lock_guard<std::mutex> lock(scene_refit_cache->mutex);
     auto& entries = scene_refit_cache->entries;
-    while (!entries.empty() && entries.begin()->first.first < scene_views.front().pose_index) {
-      entries.erase(entries.begin());
-    }
+    while (!entries.empty() && gone(entries.begin()->first)) entries.erase(entries.begin());
   }
   return "";
 }
@@ -185,6 +192,7 @@ CalibrationPipeline::Impl::sceneLinkRefit(const JointProblem& problem,
   std::map<int, std::shared_ptr<const SceneFeatures>> views;
   for (const SceneView& v : scene_views) views[v.pose_index] = v.features;
   std::vector<std::pair<int, int>> link_poses;  // StationaryPose::index of each link's views
+  std::vector<std::shared_ptr<const SceneMatchIndices>> link_matches;  // null: match again
   const auto global = [&](int local) {
     return local >= 0 && local < static_cast<int>(pose_indices.size())
                ? pose_indices[static_cast<std::size_t>(local)]
@@ -192,10 +200,13 @@ CalibrationPipeline::Impl::sceneLinkRefit(const JointProblem& problem,
   };
   for (const CameraLink& link : problem.camera_links) {
     link_poses.emplace_back(global(link.from_pose), global(link.to_pose));
+    const auto matched = scene_link_matches.find(link_poses.back());
+    link_matches.push_back(matched == scene_link_matches.end() ? nullptr : matched->second);
   }
   const double focal = std::sqrt(intrinsics->K(0, 0) * intrinsics->K(1, 1));
   const double reuse_rad = kRefitReuseShare * kHeldRotationGatePx / focal;
-  return [views = std::move(views), link_poses = std::move(link_poses), intrinsics = *intrinsics,
+  return [views = std::move(views), link_poses = std::move(link_poses),
+          link_matches = std::move(link_matches), intrinsics = *intrinsics,
           scene_settings = settings.scene_rotation, cache = scene_refit_cache,
           reuse_rad](int link, const Eigen::Matrix3d& R_near) -> std::optional<SceneRotation> {
     if (link < 0 || link >= static_cast<int>(link_poses.size())) return std::nullopt;
@@ -210,8 +221,10 @@ CalibrationPipeline::Impl::sceneLinkRefit(const JointProblem& problem,
         return hit->second.rotation;
       }
     }
-    SceneRotation again = estimateSceneRotationNear(*from->second, *to->second, intrinsics, R_near,
-                                                    kHeldRotationGatePx, scene_settings);
+    SceneRotation again = estimateSceneRotationNear(
+        *from->second, *to->second, intrinsics, R_near, kHeldRotationGatePx, scene_settings,
+        link_matches[static_cast<std::size_t>(link)].get());
+    again.matched.clear();  // the cache keeps the rotation only
     const std::lock_guard<std::mutex> lock(cache->mutex);
     cache->entries[key] = {R_near, again};
     return again;

@@ -34,9 +34,8 @@ constexpr float kSiftOffsetPx = 0.25f;
 /// `to` descriptor's best match in `from` is the same feature). Exhaustive: all squared distances
 /// at once from one matrix product, |a|^2 + |b|^2 - 2 a.b (serves both directions; a third of the
 /// time of two brute-force k-nearest-neighbour passes).
-std::vector<std::pair<int, int>> mutualRatioMatches(const cv::Mat& from, const cv::Mat& to,
-                                                    double ratio) {
-  std::vector<std::pair<int, int>> matches;
+SceneMatchIndices mutualRatioMatches(const cv::Mat& from, const cv::Mat& to, double ratio) {
+  SceneMatchIndices matches;
   if (from.rows < 2 || to.rows < 2 || from.cols != to.cols || from.type() != CV_32F ||
       to.type() != CV_32F || !from.isContinuous() || !to.isContinuous()) {
     return matches;
@@ -85,8 +84,8 @@ std::string counts(const SceneFeatures& from, const SceneFeatures& to) {
 /// result->message set when the intrinsics, the features or the matches do not allow a fit.
 bool matchViews(const SceneFeatures& from, const SceneFeatures& to,
                 const CameraIntrinsics& intrinsics, const SceneRotationSettings& settings,
-                SceneRotation* result, scene_geometry::BearingMatches* matches,
-                std::ostringstream* why) {
+                const SceneMatchIndices* given, SceneRotation* result,
+                scene_geometry::BearingMatches* matches, std::ostringstream* why) {
   const std::string intrinsics_error = intrinsics.validate();
   if (!intrinsics_error.empty()) {
     result->message = "camera intrinsics unusable: " + intrinsics_error;
@@ -97,12 +96,17 @@ bool matchViews(const SceneFeatures& from, const SceneFeatures& to,
     result->message = "features inconsistent: descriptors and bearings differ in count";
     return false;
   }
-  const std::vector<std::pair<int, int>> index_pairs =
-      mutualRatioMatches(from.descriptors, to.descriptors, settings.ratio_test);
-  result->matches = static_cast<int>(index_pairs.size());
+  result->matched =
+      given ? *given : mutualRatioMatches(from.descriptors, to.descriptors, settings.ratio_test);
+  result->matches = static_cast<int>(result->matched.size());
   matches->fx = intrinsics.K(0, 0);
   matches->fy = intrinsics.K(1, 1);
-  for (const auto& [i, j] : index_pairs) {
+  for (const auto& [i, j] : result->matched) {
+    if (i < 0 || j < 0 || i >= static_cast<int>(from.bearings.size()) ||
+        j >= static_cast<int>(to.bearings.size())) {
+      result->message = "matches inconsistent with the features: index out of range";
+      return false;
+    }
     matches->from.push_back(from.bearings[i]);
     matches->to.push_back(to.bearings[j]);
   }
@@ -226,7 +230,7 @@ SceneRotation estimateSceneRotation(const SceneFeatures& from, const SceneFeatur
   SceneRotation result;
   std::ostringstream why;
   scene_geometry::BearingMatches matches;
-  if (!matchViews(from, to, intrinsics, settings, &result, &matches, &why)) return result;
+  if (!matchViews(from, to, intrinsics, settings, nullptr, &result, &matches, &why)) return result;
   const scene_geometry::ModelFit rotation =
       scene_geometry::fitRotationOnly(matches, settings.ransac_threshold_px, R_from_to_prediction);
   scene_geometry::ModelFit general =
@@ -290,11 +294,12 @@ SceneRotation estimateSceneRotation(const SceneFeatures& from, const SceneFeatur
 SceneRotation estimateSceneRotationNear(const SceneFeatures& from, const SceneFeatures& to,
                                         const CameraIntrinsics& intrinsics,
                                         const Eigen::Matrix3d& R_from_to_near, double gate_px,
-                                        const SceneRotationSettings& settings) {
+                                        const SceneRotationSettings& settings,
+                                        const SceneMatchIndices* matched) {
   SceneRotation result;
   std::ostringstream why;
   scene_geometry::BearingMatches matches;
-  if (!matchViews(from, to, intrinsics, settings, &result, &matches, &why)) return result;
+  if (!matchViews(from, to, intrinsics, settings, matched, &result, &matches, &why)) return result;
   const double gate = std::min(gate_px, settings.ransac_threshold_px);
   const scene_geometry::HeldRotationFits fits =
       scene_geometry::fitNearRotation(matches, R_from_to_near, gate);
