@@ -429,7 +429,7 @@ JointResult withSceneLinksRefitted(const JointEstimator& estimator, WindowSnapsh
 }  // namespace
 
 AlignmentResult solveWindow(const WindowSnapshot& window_in, const PipelineSettings& settings,
-                            JointResult* as_measured) {
+                            MountTestBasis* mount_test) {
   WindowSnapshot window = window_in;
   std::string motion_note;
   MotionFigures motion_figures;
@@ -454,9 +454,17 @@ AlignmentResult solveWindow(const WindowSnapshot& window_in, const PipelineSetti
   // The joint estimate, started from the pair solve.
   // Natural-scene rotations screened: a wrong one is left out (camera_link_screening.h).
   const JointEstimator estimator(jointSettingsOf(settings));
-  JointResult measured = solveScreeningCameraLinks(estimator, window.joint, result.R_cam_imu);
+  const JointResult measured = solveScreeningCameraLinks(estimator, window.joint, result.R_cam_imu);
   const JointResult joint = withSceneLinksRefitted(estimator, &window, measured);
-  if (as_measured) *as_measured = std::move(measured);
+  if (mount_test) {
+    mount_test->as_measured = measured;
+    if (!joint.camera_links_refitted.empty()) {
+      mount_test->refitted_problem = window.joint;
+      mount_test->refitted = joint;
+      mount_test->refitted.camera_link_excess_variance_rad2 = std::max(
+          measured.camera_link_excess_variance_rad2, joint.camera_link_excess_variance_rad2);
+    }
+  }
   const std::size_t links_dropped = joint.camera_links_left_out.size();
   const std::string sensors = settings.imu_orientation == ImuOrientationSource::kMagnetometer
                                   ? " (camera, accelerometer, magnetometer; gyro not used)"
@@ -478,7 +486,8 @@ AlignmentResult solveWindow(const WindowSnapshot& window_in, const PipelineSetti
                   " natural-scene rotations" + otherSolutions(window, joint) +
                   (joint.camera_links_refitted.empty()
                        ? ""
-                       : " (" + std::to_string(joint.camera_links_refitted.size()) +
+                       : " (" + std::to_string(joint.camera_links_refitted.size()) + " of " +
+                             std::to_string(window.joint.camera_links.size()) +
                              " fitted again with the rotation held near the estimate's)") +
                   (links_dropped > 0 ? " (" + std::to_string(links_dropped) +
                                            " more left out: residual beyond chi-square(3) "
