@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <random>
 #include <string>
 #include <vector>
@@ -62,6 +64,15 @@ inline double boardEquivalentErrorDeg(const CalibrationPipeline& pipeline,
   const JointResult r = JointEstimator(jointSettingsOf(pipeline.settings())).solve(board, R_start);
   EXPECT_TRUE(r.ok) << r.message;
   return rad2deg(geodesicDistance(r.R_cam_imu, R_cam_imu_true));
+}
+
+/// CIA_SCENE_SEEDS=N: the Monte Carlo tests run seeds 100 .. 100 + N - 1 of each scene (20: the
+/// issue's size, the figures in BENCHMARKS.md); unset: `default_count`, to keep the test command
+/// short.
+inline int sceneSeedCount(int default_count) {
+  const char* text = std::getenv("CIA_SCENE_SEEDS");
+  const int n = text ? std::atoi(text) : 0;
+  return n > 0 ? n : default_count;
 }
 
 inline SceneOutcome runScene(const std::string& scenario, std::uint64_t seed,

@@ -1,6 +1,7 @@
-// Calibration without a board, Monte Carlo (issue 26's targets; labelled statistical): 20 seeds of
-// the simulator's room scenarios with a consumer IMU (scene_sessions.h): RMS error, answers (the
-// chi-square test passing), and the reported 1-sigma covering the errors whenever it passes.
+// Calibration without a board, Monte Carlo (issue 26's targets; labelled statistical): 10 seeds
+// (CIA_SCENE_SEEDS=20: the issue's size, BENCHMARKS.md) of the simulator's room scenarios with a
+// consumer IMU (scene_sessions.h): RMS error, answers (the chi-square test passing), and the
+// reported 1-sigma covering the errors whenever it passes.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,6 +14,10 @@
 namespace camera_imu_alignment {
 namespace {
 
+/// Seeds per scene unless CIA_SCENE_SEEDS says (the issue's Monte Carlo size, 20, in
+/// BENCHMARKS.md: about 5 min for both scenes).
+constexpr int kDefaultSeeds = 10;
+
 struct Statistics {
   std::vector<double> error_deg;        ///< of the consistent estimates
   std::vector<double> board_error_deg;  ///< the same seeds with a board at every rest
@@ -21,8 +26,9 @@ struct Statistics {
 
 Statistics runSeeds(const std::string& scenario) {
   Statistics s;
-  for (std::uint64_t seed = 100; seed < 120; ++seed) {
-    const test::SceneOutcome o = test::runScene(scenario, seed);
+  const int seeds = test::sceneSeedCount(kDefaultSeeds);
+  for (int k = 0; k < seeds; ++k) {
+    const test::SceneOutcome o = test::runScene(scenario, 100 + k);
     ++s.seeds;
     s.board_error_deg.push_back(o.board_error_deg);
     if (!o.consistent) continue;
@@ -56,7 +62,7 @@ double rms(const std::vector<double>& v) {
 // level with a margin.
 TEST(SceneMonteCarlo, RobotStopsConsumer) {
   const Statistics s = runSeeds("room_robot");
-  EXPECT_GE(s.consistent, 18);
+  EXPECT_GE(s.consistent, s.seeds * 9 / 10);
   EXPECT_EQ(s.within_3_sigma, s.consistent);
   EXPECT_LE(rms(s.error_deg), 0.25);
 }
@@ -69,7 +75,7 @@ TEST(SceneMonteCarlo, RobotStopsConsumer) {
 // 0.0571 deg.
 TEST(SceneMonteCarlo, HandHeldConsumer) {
   const Statistics s = runSeeds("room_handheld");
-  EXPECT_GE(s.consistent, 18);
+  EXPECT_GE(s.consistent, s.seeds * 9 / 10);
   EXPECT_EQ(s.within_3_sigma, s.consistent);
   EXPECT_LE(rms(s.error_deg), 0.08);
   EXPECT_LE(rms(s.error_deg), 1.5 * rms(s.board_error_deg));
