@@ -371,6 +371,8 @@ TEST(JointCameraLinks, LinksAreFittedAgainWithTheRotationHeldNearTheEstimate) {
       out->ok = true;
       out->R_from_to = refit_of[j];
       out->cov_rad2 = std::pow(deg2rad(0.05), 2) * Eigen::Matrix3d::Identity();
+      // A compromise's refit finds the moved object as a second motion.
+      out->second_motion_inliers = compromised[j] ? 40 : 0;
       return out;
     };
     MountTestBasis basis;
@@ -397,6 +399,15 @@ TEST(JointCameraLinks, LinksAreFittedAgainWithTheRotationHeldNearTheEstimate) {
     }
     EXPECT_NE(with.message.find("fitted again with the rotation held"), std::string::npos)
         << with.message;
+    // Of the refitted links, those whose refit found a second motion are counted: here every one
+    // taken (only the compromised links change).
+    EXPECT_EQ(with.joint->camera_links_second_motion, refitted) << "seed " << seed;
+    if (!refitted.empty()) {
+      EXPECT_NE(with.message.find(std::to_string(refitted.size()) +
+                                  " of them with a moved object as a second motion"),
+                std::string::npos)
+          << with.message;
+    }
     with_error.push_back(rad2deg(geodesicDistance(with.R_cam_imu, sim.R_cam_imu)));
     without_error.push_back(rad2deg(geodesicDistance(without.R_cam_imu, sim.R_cam_imu)));
     consistent += with.joint->consistent();

@@ -138,6 +138,9 @@ struct JointResult {
   /// again from the views with the rotation held near this estimate's (natural scene: a moved
   /// object in view; pipeline/calibration_pipeline.h, WindowSnapshot::scene_link_refit). Sorted.
   std::vector<int> camera_links_refitted;
+  /// Of camera_links_refitted, those fitted as two motions sharing the rotation (an object moved
+  /// between the views: SceneRotation::second_motion_inliers > 0). Sorted.
+  std::vector<int> camera_links_second_motion;
   /// Isotropic variance added to every rest's camera covariance (rad^2 per axis) because the
   /// rests' camera residuals exceeded their covariances (JointSettings::camera_excess_level): the
   /// camera's noise as the recording shows it. 0 when not.

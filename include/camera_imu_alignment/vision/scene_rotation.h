@@ -98,6 +98,9 @@ struct SceneRotation {
   Eigen::Vector3d translation_direction = Eigen::Vector3d::Zero();
   int matches = 0;  ///< after the ratio test and the mutual check
   int inliers = 0;  ///< of the chosen model
+  /// Of the inliers, those on a second motion that shares the rotation (an object slid between
+  /// the views; estimateSceneRotationNear only): they measure the rotation too.
+  int second_motion_inliers = 0;
   /// The inliers' noise per image coordinate under the chosen model (pixels): the RMS of their
   /// first-order geometric distances over the degrees of freedom; the sigma of cov_rad2.
   double residual_rms_px = 0;
@@ -126,7 +129,9 @@ SceneRotation estimateSceneRotation(const SceneFeatures& from, const SceneFeatur
 /// refined freely and chosen by GRIC: for a pair whose free fit the IMU contradicts. Two motions in
 /// view that share the rotation (the room, and an object moved between the views) make a free fit
 /// at a loose gate average them into a compromise; with the rotation held, the translation found
-/// holds one of them, and either gives the camera's rotation. The gate must cover the prediction's
+/// holds one of them, and either gives the camera's rotation. The matches outside that motion's
+/// gate may hold a second translation with the same rotation: the two are then fitted together
+/// (second_motion_inliers) when GRIC prefers them. The gate must cover the prediction's
 /// error (pixels: focal length times its angle) and the image noise. Results as
 /// estimateSceneRotation (no alternatives; no prediction check). `matched` (optional): the pair's
 /// matches from an earlier fit (SceneRotation::matched), which saves matching them again.

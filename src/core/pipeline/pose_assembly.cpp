@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "calibration_pipeline_impl.h"
 #include "camera_imu_alignment/estimation/camera_link_screening.h"
@@ -374,20 +376,41 @@ WindowSnapshot CalibrationPipeline::Impl::snapshot() const {
 
 namespace {
 
-/// How many natural-scene rotations were taken as a near-planar view's other solution, by the
-/// gyro's consensus (WindowSnapshot::link_consensus) and by the joint estimate's screening.
-std::string otherSolutions(const WindowSnapshot& window, const JointResult& joint) {
+/// What became of the window's natural-scene rotations, as one parenthetical clause (empty when
+/// nothing did): those taken as a near-planar view's other solution, by the gyro's consensus
+/// (WindowSnapshot::link_consensus) and by the joint estimate's screening; those fitted again with
+/// the rotation held (JointResult::camera_links_refitted); those left out by the screening.
+std::string sceneLinkNotes(const WindowSnapshot& window, const JointResult& joint) {
   const auto taken = [](const std::vector<int>& used) {
     return std::count_if(used.begin(), used.end(), [](int a) { return a >= 0; });
   };
   const auto by_gyro = taken(window.link_consensus.alternative_used);
   const auto by_screening = taken(joint.camera_link_alternative_used);
-  if (by_gyro + by_screening == 0) return "";
-  std::ostringstream s;
-  s << " (" << by_gyro + by_screening << " of them the view's other solution: " << by_gyro
-    << " by the gyro's consensus of " << window.link_consensus.consensus << " of "
-    << window.link_consensus.links_judged << ", " << by_screening << " by the screening)";
-  return s.str();
+  std::vector<std::string> notes;
+  if (by_gyro + by_screening > 0) {
+    std::ostringstream s;
+    s << by_gyro + by_screening << " of them the view's other solution: " << by_gyro
+      << " by the gyro's consensus of " << window.link_consensus.consensus << " of "
+      << window.link_consensus.links_judged << ", " << by_screening << " by the screening";
+    notes.push_back(s.str());
+  }
+  if (!joint.camera_links_refitted.empty()) {
+    const std::size_t two = joint.camera_links_second_motion.size();
+    notes.push_back(
+        std::to_string(joint.camera_links_refitted.size()) + " of " +
+        std::to_string(window.joint.camera_links.size()) +
+        " fitted again with the rotation held near the estimate's" +
+        (two > 0 ? ", " + std::to_string(two) + " of them with a moved object as a second motion"
+                 : ""));
+  }
+  if (!joint.camera_links_left_out.empty()) {
+    notes.push_back(std::to_string(joint.camera_links_left_out.size()) +
+                    " more left out: residual beyond chi-square(3) p 1e-4");
+  }
+  if (notes.empty()) return "";
+  std::string out = " (";
+  for (size_t k = 0; k < notes.size(); ++k) out += (k > 0 ? "; " : "") + notes[k];
+  return out + ")";
 }
 
 /// The natural scene's links fitted again from their views with the rotation held near the joint
@@ -404,7 +427,7 @@ JointResult withSceneLinksRefitted(const JointEstimator& estimator, WindowSnapsh
     return joint;
   }
   JointProblem refitted = problem;
-  std::vector<int> changed;
+  std::vector<int> changed, second_motion;
   for (std::size_t j = 0; j < refitted.camera_links.size(); ++j) {
     CameraLink& link = refitted.camera_links[j];
     const Eigen::Matrix3d R_fit =
@@ -417,11 +440,13 @@ JointResult withSceneLinksRefitted(const JointEstimator& estimator, WindowSnapsh
     link.R_from_to = again->R_from_to;
     link.cov_rad2 = again->cov_rad2;
     changed.push_back(static_cast<int>(j));
+    if (again->second_motion_inliers > 0) second_motion.push_back(static_cast<int>(j));
   }
   if (changed.empty()) return joint;
   JointResult second = solveScreeningCameraLinks(estimator, refitted, joint.R_cam_imu);
   if (!second.ok) return joint;
   second.camera_links_refitted = std::move(changed);
+  second.camera_links_second_motion = std::move(second_motion);
   window->joint = std::move(refitted);
   return second;
 }
@@ -483,16 +508,7 @@ AlignmentResult solveWindow(const WindowSnapshot& window_in, const PipelineSetti
         window.joint.camera_links.empty()
             ? ""
             : ", " + std::to_string(window.joint.camera_links.size() - links_dropped) +
-                  " natural-scene rotations" + otherSolutions(window, joint) +
-                  (joint.camera_links_refitted.empty()
-                       ? ""
-                       : " (" + std::to_string(joint.camera_links_refitted.size()) + " of " +
-                             std::to_string(window.joint.camera_links.size()) +
-                             " fitted again with the rotation held near the estimate's)") +
-                  (links_dropped > 0 ? " (" + std::to_string(links_dropped) +
-                                           " more left out: residual beyond chi-square(3) "
-                                           "p 1e-4)"
-                                     : "");
+                  " natural-scene rotations" + sceneLinkNotes(window, joint);
     result.message = "joint estimate" + sensors + " over " +
                      std::to_string(window.joint.poses.size()) + " poses" + motion + scene +
                      ": chi2/dof " + fmt(joint.dof > 0 ? joint.chi2 / joint.dof : 0.0) +

@@ -30,6 +30,9 @@ struct ModelFit {
   Eigen::Vector3d t_from = Eigen::Vector3d::Zero();  ///< general model only (unit)
   std::vector<bool> inlier;                          ///< per match
   int inliers = 0;
+  /// Of the inliers, those on a second motion sharing the rotation (fitNearRotation: an object
+  /// slid between the views); 0 for a one-motion fit.
+  int second_motion = 0;
   /// Per match: squared first-order geometric distance (px^2) of the match to the model; its
   /// expectation for an inlier is codimension * sigma^2 (2 for rotation-only, 1 for general).
   std::vector<double> distance2_px2;
@@ -66,9 +69,19 @@ ModelFit fitGeneralFrom(const BearingMatches& matches, double threshold_px,
 /// refined (rotation free) at `gate_px`, with the screens. Two motions in view that share the
 /// rotation (the room, and an object slid between the views: another translation) are then not
 /// averaged into one compromise, as a free 5-point RANSAC at a loose gate can: the translation
-/// found holds one of them.
+/// found holds one of them. When the matches outside that
+/// translation's gate hold a second one (R_from_to still held), the two are fitted together (one
+/// rotation, two translation directions; each match belongs to the nearer): `two_motions` when
+/// GRIC prefers them to the general model of one. The object's matches then measure the rotation
+/// too (ModelFit::second_motion counts them; ModelFit::t_from is the first motion's).
 struct HeldRotationFits {
   ModelFit rotation, general;
+  /// The general model with a second motion, when found and preferred to `general` by GRIC
+  /// (found = false otherwise). The choice between the rotation-only model and the general one
+  /// is made with `general`: a second motion's matches are outliers of the rotation-only model,
+  /// and counting them would take the general model for a pure rotation, which measures the
+  /// rotation less well.
+  ModelFit two_motions;
 };
 HeldRotationFits fitNearRotation(const BearingMatches& matches, const Eigen::Matrix3d& R_from_to,
                                  double gate_px);

@@ -137,6 +137,7 @@ void takeFit(const scene_geometry::ModelFit& fit, bool rotation_only,
              const SceneRotationSettings& settings, SceneRotation* result,
              std::ostringstream* why) {
   result->inliers = fit.found ? fit.inliers : 0;
+  result->second_motion_inliers = fit.found ? fit.second_motion : 0;
   *why << ", " << result->inliers << " inliers";
   if (!fit.found || result->inliers < settings.min_inliers) {
     result->message = "too few inliers (" + why->str() + "; min_inliers " +
@@ -156,6 +157,9 @@ void takeFit(const scene_geometry::ModelFit& fit, bool rotation_only,
   result->residual_rms_px = fit.sigma_px;
   *why << ", " << (rotation_only ? "rotation only" : "general motion") << ", " << fit.sigma_px
        << " px";
+  if (fit.second_motion > 0)
+    *why << ", " << fit.second_motion
+         << " of them on a second motion with the same rotation (an object moved)";
   result->ok = true;
   result->message = why->str();
 }
@@ -305,7 +309,9 @@ SceneRotation estimateSceneRotationNear(const SceneFeatures& from, const SceneFe
       scene_geometry::fitNearRotation(matches, R_from_to_near, gate);
   const bool use_rotation = rotationOnlyChosen(fits.rotation, fits.general);
   why << ", the rotation held near the prediction (gate " << gate << " px)";
-  takeFit(use_rotation ? fits.rotation : fits.general, use_rotation, settings, &result, &why);
+  const scene_geometry::ModelFit& general =
+      fits.two_motions.found ? fits.two_motions : fits.general;
+  takeFit(use_rotation ? fits.rotation : general, use_rotation, settings, &result, &why);
   return result;
 }
 
