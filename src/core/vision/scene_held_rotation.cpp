@@ -21,7 +21,6 @@ using model_fit::distances2;
 using model_fit::inFrontOfBoth;
 using model_fit::kCauchyScale2;
 using model_fit::kChi2Bound999;
-using model_fit::kChi2Median;
 using model_fit::kMinSigmaPx;
 using model_fit::kRefinementRounds;
 using model_fit::levenbergMarquardt;
@@ -29,6 +28,7 @@ using model_fit::numericJacobian;
 using model_fit::perturb;
 using model_fit::refineAndSelect;
 using model_fit::residuals;
+using model_fit::robustSigma2;
 using model_fit::sampsonResidual;
 using model_fit::State;
 using model_fit::Weights;
@@ -150,19 +150,9 @@ ModelFit refineTwoMotions(const BearingMatches& m, TwoMotions s, double threshol
   std::vector<double> d2;
   std::vector<bool> on_b;
   double sigma2 = 0;
-  // The robust noise: the median distance of the matches within the gate.
-  const auto robustSigma2 = [&]() {
-    std::vector<double> gated;
-    for (double d : d2) {
-      if (d < threshold2) gated.push_back(d);
-    }
-    if (gated.empty()) return 0.0;
-    std::nth_element(gated.begin(), gated.begin() + gated.size() / 2, gated.end());
-    return std::max(gated[gated.size() / 2] / kChi2Median[1], kMinSigmaPx * kMinSigmaPx);
-  };
   for (int round = 0; round < kRefinementRounds; ++round) {
     nearerMotion(m, s, &d2, &on_b);
-    sigma2 = robustSigma2();
+    sigma2 = robustSigma2(d2, threshold2, 1);
     idx_a.clear();
     idx_b.clear();
     w_a.clear();
@@ -179,7 +169,7 @@ ModelFit refineTwoMotions(const BearingMatches& m, TwoMotions s, double threshol
   // Final: the matches within the chi-square 99.9 % bound of the robust noise, in front of both
   // cameras under their motion; their least-squares fit; the noise from their residuals.
   nearerMotion(m, s, &d2, &on_b);
-  sigma2 = robustSigma2();
+  sigma2 = robustSigma2(d2, threshold2, 1);
   const double bound = std::min(threshold2, kChi2Bound999[1] * sigma2);
   idx_a.clear();
   idx_b.clear();

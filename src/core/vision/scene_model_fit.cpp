@@ -125,6 +125,16 @@ std::vector<double> distances2(const BearingMatches& m, const State& s, bool gen
   return d2;
 }
 
+double robustSigma2(const std::vector<double>& d2, double threshold2, int codim) {
+  std::vector<double> gated;
+  for (double d : d2) {
+    if (d < threshold2) gated.push_back(d);
+  }
+  if (gated.empty()) return 0;
+  std::nth_element(gated.begin(), gated.begin() + gated.size() / 2, gated.end());
+  return std::max(gated[gated.size() / 2] / kChi2Median[codim], kMinSigmaPx * kMinSigmaPx);
+}
+
 /// The matches within the chi-square 99.9 % bound of the noise at state `s` (and within the
 /// RANSAC gate; with `cheirality`, in front of both cameras). The noise is the median distance of
 /// every match within the gate (robust: not from a previous selection, whose trimming would shrink
@@ -134,15 +144,9 @@ std::vector<int> selectInliers(const BearingMatches& m, const State& s, double t
   const int codim = general ? 1 : 2;
   const double threshold2 = threshold_px * threshold_px;
   const std::vector<double> d2 = distances2(m, s, general);
-  std::vector<double> gated_d2;
-  for (double d : d2) {
-    if (d < threshold2) gated_d2.push_back(d);
-  }
   std::vector<int> idx;
-  if (gated_d2.empty()) return idx;
-  std::nth_element(gated_d2.begin(), gated_d2.begin() + gated_d2.size() / 2, gated_d2.end());
-  const double sigma2 =
-      std::max(gated_d2[gated_d2.size() / 2] / kChi2Median[codim], kMinSigmaPx * kMinSigmaPx);
+  const double sigma2 = robustSigma2(d2, threshold2, codim);
+  if (!(sigma2 > 0)) return idx;
   const double bound = std::min(threshold2, kChi2Bound999[codim] * sigma2);
   for (size_t i = 0; i < d2.size(); ++i) {
     if (d2[i] < bound && (!cheirality || inFrontOfBoth(s, m.from[i], m.to[i]))) {

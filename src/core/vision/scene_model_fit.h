@@ -61,6 +61,11 @@ VectorXd residuals(const BearingMatches& m, const State& s, const std::vector<in
 /// Squared distances of every match (px^2; the residual's squared norm).
 std::vector<double> distances2(const BearingMatches& m, const State& s, bool general);
 
+/// The robust noise per coordinate (px^2) of squared distances `d2` of codimension `codim`: the
+/// median of those below `threshold2` over chi-square(codim)'s median, at least kMinSigmaPx^2; 0
+/// when none is below.
+double robustSigma2(const std::vector<double>& d2, double threshold2, int codim);
+
 /// From a model's state: robust rounds over the matches within the gate `threshold_px`, the final
 /// inliers, their fit and the rotation's covariance (scene_model_fit.cpp has the details).
 ModelFit refineAndSelect(const BearingMatches& m, State s, double threshold_px, bool general,
