@@ -77,8 +77,9 @@ void BM_ImageSharpness(benchmark::State& state) {
 }
 BENCHMARK(BM_ImageSharpness)->Unit(benchmark::kMillisecond);
 
-// Args: max_features per view, image_scale x 100. Matching (ratio test, mutual check) and the
-// rotation. Counter error_mdeg: the rotation's error (millidegrees).
+// Args: max_features per view, image_scale x 100, refine_matches (0/1). Matching (ratio test,
+// mutual check), the matches' refinement at full resolution and the rotation. Counter error_mdeg:
+// the rotation's error (millidegrees).
 void BM_PairRotation(benchmark::State& state) {
   cia::SceneFeatureSettings settings;
   settings.max_features = static_cast<int>(state.range(0));
@@ -86,22 +87,27 @@ void BM_PairRotation(benchmark::State& state) {
   const cia::CameraIntrinsics camera = intrinsics();
   const cia::SceneFeatures from = cia::extractSceneFeatures(views().first, camera, settings, 0);
   const cia::SceneFeatures to = cia::extractSceneFeatures(views().second, camera, settings, 1);
+  cia::SceneRotationSettings rotation_settings;
+  rotation_settings.refine_matches = state.range(2) != 0;
   cia::SceneRotation r;
   for (auto _ : state) {
-    r = cia::estimateSceneRotation(from, to, camera, std::nullopt, cia::SceneRotationSettings());
+    r = cia::estimateSceneRotation(from, to, camera, std::nullopt, rotation_settings);
     benchmark::DoNotOptimize(r.R_from_to.data());
   }
   if (!r.ok) state.SkipWithError(r.message.c_str());
   state.counters["matches"] = r.matches;
   state.counters["inliers"] = r.inliers;
+  state.counters["refined"] = r.refined_matches;
   state.counters["error_mdeg"] =
       1e3 * 180 / M_PI * Eigen::AngleAxisd(r.R_from_to.transpose() * views().R_from_to).angle();
 }
 BENCHMARK(BM_PairRotation)
-    ->Args({1500, 100})
-    ->Args({1000, 100})
-    ->Args({1500, 50})
-    ->Args({1000, 50})
+    ->Args({1500, 100, 0})
+    ->Args({1000, 100, 0})
+    ->Args({1500, 50, 0})
+    ->Args({1000, 50, 0})
+    ->Args({1500, 100, 1})
+    ->Args({1000, 50, 1})
     ->Unit(benchmark::kMillisecond);
 
 // A link fitted again in the solve (estimateSceneRotationNear: the rotation held at the truth,

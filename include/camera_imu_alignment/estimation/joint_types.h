@@ -116,6 +116,10 @@ struct CameraLink {
     Eigen::Matrix3d cov_rad2 = Eigen::Matrix3d::Zero();
   };
   std::vector<Alternative> alternatives;
+  /// The spread between solutions the gyro's consensus could not choose between (rad^2, frames as
+  /// cov_rad2; estimation/camera_link_consensus.h): already in cov_rad2 and the alternatives'
+  /// covariances, and added to the covariance of the link fitted again.
+  Eigen::Matrix3d undecided_rad2 = Eigen::Matrix3d::Zero();
 };
 
 /// Raw gyro samples from the end of rest `from_pose` to the start of rest `to_pose`. Sample i holds

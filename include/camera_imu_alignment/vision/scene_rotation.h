@@ -23,16 +23,17 @@
 namespace camera_imu_alignment {
 
 struct SceneFeatureSettings {
-  int max_features = 1500;  ///< strongest SIFT keypoints kept per view
+  int max_features = 1000;  ///< strongest SIFT keypoints kept per view
   int octave_layers = 3;    ///< SIFT layers per octave (fewer: faster, fewer keypoints)
   /// SIFT's contrast threshold (OpenCV's default; OpenCV divides it by octave_layers): lower finds
   /// keypoints in fainter texture (a plain wall, a table), weaker ones.
   double contrast_threshold = 0.04;
   /// The image is resized by this factor (0 < image_scale <= 1, area averaging) before SIFT;
-  /// keypoints and bearings are in the full image's pixels. 0.5 costs about half the time (SIFT's
-  /// first octave works at twice the resolution it is given), drops the finest scale and doubles
-  /// the rotation's error (still honest: BENCHMARKS.md, "Natural-scene rotation").
-  double image_scale = 1.0;
+  /// keypoints and bearings are in the full image's pixels. 0.5 costs less than half the time of
+  /// 1 (SIFT's first octave works at twice the resolution it is given) and drops the finest
+  /// scale; the matches' refinement at full resolution (SceneRotationSettings::refine_matches)
+  /// gives the precision back (BENCHMARKS.md, "Natural-scene rotation").
+  double image_scale = 0.5;
 };
 
 /// The features of one view (a rest's sharpest frame).
@@ -43,6 +44,9 @@ struct SceneFeatures {
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;                    ///< one row per keypoint (CV_32F, SIFT)
   std::vector<Eigen::Vector3d> bearings;  ///< unit vectors, camera frame, one per keypoint
+  /// The full-resolution mono8 image the features came from (shared, not copied), for the
+  /// matches' refinement; empty: the matches stay where the keypoints were detected.
+  cv::Mat image;
 };
 
 /// Sharpness of a mono8 image (variance of its Laplacian; larger is sharper): picks a rest's
@@ -73,10 +77,25 @@ struct SceneRotationSettings {
   /// A near-planar view's other essential matrix is kept as an alternative (SceneRotation) when it
   /// holds at least this share of the chosen model's inliers.
   double alternative_inlier_share = 0.9;
+  /// Each match's position in the `to` view refined at the full resolution: the `to` image warped
+  /// into the `from` view by the matches' homography, then Lucas-Kanade on a window around the
+  /// `from` keypoint (both views' images needed). What SIFT at a reduced image_scale loses in
+  /// localisation, at a fraction of a full-resolution SIFT's cost.
+  bool refine_matches = true;
+  /// A refinement that moves a match further than this (pixels of the full image) from where it was
+  /// detected has locked onto other texture: the match keeps its detected position.
+  double refine_max_shift_px = 2.0;
 };
 
-/// Matches between two views' features: (index into `from`, index into `to`).
-using SceneMatchIndices = std::vector<std::pair<int, int>>;
+/// Matches between two views' features.
+struct SceneMatches {
+  std::vector<std::pair<int, int>> indices;  ///< (index into `from`, index into `to`)
+  /// Per match, its position in the `to` image (pixels; refined where `refined`, else the
+  /// keypoint's). Empty: the keypoints' positions.
+  std::vector<cv::Point2f> to_px;
+  int refined = 0;  ///< matches whose `to` position was refined at the full resolution
+  size_t size() const { return indices.size(); }
+};
 
 /// Another rotation that explains the matches about as well as the chosen one (a near-planar
 /// view's second essential matrix): the joint estimate may take it instead when the IMU says so.
@@ -96,8 +115,9 @@ struct SceneRotation {
   SceneMotionModel model = SceneMotionModel::kRotationOnly;
   /// kGeneral: the unit direction of the `to` camera centre in the `from` camera frame.
   Eigen::Vector3d translation_direction = Eigen::Vector3d::Zero();
-  int matches = 0;  ///< after the ratio test and the mutual check
-  int inliers = 0;  ///< of the chosen model
+  int matches = 0;          ///< after the ratio test and the mutual check
+  int refined_matches = 0;  ///< of them, placed at the full resolution (refine_matches)
+  int inliers = 0;          ///< of the chosen model
   /// Of the inliers, those on a second motion that shares the rotation (an object slid between
   /// the views; estimateSceneRotationNear only): they measure the rotation too.
   int second_motion_inliers = 0;
@@ -109,7 +129,7 @@ struct SceneRotation {
   std::vector<SceneRotationAlternative> alternatives;
   /// The matches the fit started from (ratio test and mutual check), to fit the pair again
   /// without matching (estimateSceneRotationNear).
-  SceneMatchIndices matched;
+  SceneMatches matched;
 };
 
 /// The rotation between two views. `R_from_to_prediction` (e.g. the gyro's, through the current
@@ -139,6 +159,6 @@ SceneRotation estimateSceneRotationNear(const SceneFeatures& from, const SceneFe
                                         const CameraIntrinsics& intrinsics,
                                         const Eigen::Matrix3d& R_from_to_near, double gate_px,
                                         const SceneRotationSettings& settings,
-                                        const SceneMatchIndices* matched = nullptr);
+                                        const SceneMatches* matched = nullptr);
 
 }  // namespace camera_imu_alignment

@@ -154,7 +154,7 @@ struct CalibrationPipeline::Impl {
   };
   std::shared_ptr<SceneRefitCache> scene_refit_cache = std::make_shared<SceneRefitCache>();
   /// The matches of each link (by its poses' StationaryPose::index), for fitting it again.
-  std::map<std::pair<int, int>, std::shared_ptr<const SceneMatchIndices>> scene_link_matches;
+  std::map<std::pair<int, int>, std::shared_ptr<const SceneMatches>> scene_link_matches;
   int scenes_started = 0;
   std::uint64_t rotations_refused_by_imu = 0;  ///< scene rotations the IMU's angle contradicts
 

@@ -438,7 +438,7 @@ JointResult withSceneLinksRefitted(const JointEstimator& estimator, WindowSnapsh
       continue;
     link.alternatives.push_back({link.R_from_to, link.cov_rad2});
     link.R_from_to = again->R_from_to;
-    link.cov_rad2 = again->cov_rad2;
+    link.cov_rad2 = again->cov_rad2 + link.undecided_rad2;
     changed.push_back(static_cast<int>(j));
     if (again->second_motion_inliers > 0) second_motion.push_back(static_cast<int>(j));
   }

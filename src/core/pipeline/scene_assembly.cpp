@@ -141,7 +141,7 @@ std::string CalibrationPipeline::Impl::assessScene(const StationarySegment& segm
     }
     entry->camera_links.push_back(link);
     scene_link_matches[{it->pose_index, pose->index}] =
-        std::make_shared<const SceneMatchIndices>(rotation.matched);
+        std::make_shared<const SceneMatches>(rotation.matched);
     pose->scene_links.push_back(std::move(summary));
     if (!anchor || rotation.inliers > anchor_rotation.inliers) {
       anchor = &*it;
@@ -192,7 +192,7 @@ CalibrationPipeline::Impl::sceneLinkRefit(const JointProblem& problem,
   std::map<int, std::shared_ptr<const SceneFeatures>> views;
   for (const SceneView& v : scene_views) views[v.pose_index] = v.features;
   std::vector<std::pair<int, int>> link_poses;  // StationaryPose::index of each link's views
-  std::vector<std::shared_ptr<const SceneMatchIndices>> link_matches;  // null: match again
+  std::vector<std::shared_ptr<const SceneMatches>> link_matches;  // null: match again
   const auto global = [&](int local) {
     return local >= 0 && local < static_cast<int>(pose_indices.size())
                ? pose_indices[static_cast<std::size_t>(local)]
@@ -224,7 +224,7 @@ CalibrationPipeline::Impl::sceneLinkRefit(const JointProblem& problem,
     SceneRotation again = estimateSceneRotationNear(
         *from->second, *to->second, intrinsics, R_near, kHeldRotationGatePx, scene_settings,
         link_matches[static_cast<std::size_t>(link)].get());
-    again.matched.clear();  // the cache keeps the rotation only
+    again.matched = SceneMatches();  // the cache keeps the rotation only
     const std::lock_guard<std::mutex> lock(cache->mutex);
     cache->entries[key] = {R_near, again};
     return again;

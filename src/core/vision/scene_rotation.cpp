@@ -16,6 +16,7 @@
 
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "scene_geometry.h"
+#include "scene_match_refinement.h"
 
 namespace camera_imu_alignment {
 namespace {
@@ -34,8 +35,9 @@ constexpr float kSiftOffsetPx = 0.25f;
 /// `to` descriptor's best match in `from` is the same feature). Exhaustive: all squared distances
 /// at once from one matrix product, |a|^2 + |b|^2 - 2 a.b (serves both directions; a third of the
 /// time of two brute-force k-nearest-neighbour passes).
-SceneMatchIndices mutualRatioMatches(const cv::Mat& from, const cv::Mat& to, double ratio) {
-  SceneMatchIndices matches;
+std::vector<std::pair<int, int>> mutualRatioMatches(const cv::Mat& from, const cv::Mat& to,
+                                                    double ratio) {
+  std::vector<std::pair<int, int>> matches;
   if (from.rows < 2 || to.rows < 2 || from.cols != to.cols || from.type() != CV_32F ||
       to.type() != CV_32F || !from.isContinuous() || !to.isContinuous()) {
     return matches;
@@ -80,11 +82,28 @@ std::string counts(const SceneFeatures& from, const SceneFeatures& to) {
   return s.str();
 }
 
+/// `matched`'s positions in the `to` image refined at the full resolution (refine_matches).
+void refineMatches(const SceneFeatures& from, const SceneFeatures& to,
+                   const SceneRotationSettings& settings, SceneMatches* matched) {
+  if (!settings.refine_matches || from.image.empty() || to.image.empty() ||
+      from.keypoints.size() != from.bearings.size() || to.keypoints.size() != to.bearings.size())
+    return;
+  std::vector<cv::Point2f> from_px, to_px;
+  for (const auto& [i, j] : matched->indices) {
+    from_px.push_back(from.keypoints[static_cast<size_t>(i)].pt);
+    to_px.push_back(to.keypoints[static_cast<size_t>(j)].pt);
+  }
+  std::vector<bool> refined;
+  matched->to_px = scene_geometry::refineMatchesAtFullResolution(
+      from.image, to.image, from_px, to_px, settings.refine_max_shift_px, &refined);
+  matched->refined = static_cast<int>(std::count(refined.begin(), refined.end(), true));
+}
+
 /// The views' matches as bearings (result->matches and the counts in `why`); false with
 /// result->message set when the intrinsics, the features or the matches do not allow a fit.
 bool matchViews(const SceneFeatures& from, const SceneFeatures& to,
                 const CameraIntrinsics& intrinsics, const SceneRotationSettings& settings,
-                const SceneMatchIndices* given, SceneRotation* result,
+                const SceneMatches* given, SceneRotation* result,
                 scene_geometry::BearingMatches* matches, std::ostringstream* why) {
   const std::string intrinsics_error = intrinsics.validate();
   if (!intrinsics_error.empty()) {
@@ -96,21 +115,42 @@ bool matchViews(const SceneFeatures& from, const SceneFeatures& to,
     result->message = "features inconsistent: descriptors and bearings differ in count";
     return false;
   }
-  result->matched =
-      given ? *given : mutualRatioMatches(from.descriptors, to.descriptors, settings.ratio_test);
-  result->matches = static_cast<int>(result->matched.size());
-  matches->fx = intrinsics.K(0, 0);
-  matches->fy = intrinsics.K(1, 1);
-  for (const auto& [i, j] : result->matched) {
+  SceneMatches& matched = result->matched;
+  if (given) {
+    matched = *given;
+  } else {
+    matched.indices = mutualRatioMatches(from.descriptors, to.descriptors, settings.ratio_test);
+  }
+  for (const auto& [i, j] : matched.indices) {
     if (i < 0 || j < 0 || i >= static_cast<int>(from.bearings.size()) ||
         j >= static_cast<int>(to.bearings.size())) {
       result->message = "matches inconsistent with the features: index out of range";
       return false;
     }
-    matches->from.push_back(from.bearings[i]);
-    matches->to.push_back(to.bearings[j]);
+  }
+  if (!matched.to_px.empty() && matched.to_px.size() != matched.indices.size()) {
+    result->message = "matches inconsistent: refined positions and matches differ in count";
+    return false;
+  }
+  if (!given) refineMatches(from, to, settings, &matched);
+  result->matches = static_cast<int>(matched.size());
+  result->refined_matches = matched.refined;
+  matches->fx = intrinsics.K(0, 0);
+  matches->fy = intrinsics.K(1, 1);
+  std::vector<cv::Point2d> refined_normalised;
+  if (!matched.to_px.empty()) refined_normalised = intrinsics.undistortToNormalized(matched.to_px);
+  for (size_t k = 0; k < matched.indices.size(); ++k) {
+    const auto [i, j] = matched.indices[k];
+    matches->from.push_back(from.bearings[static_cast<size_t>(i)]);
+    Eigen::Vector3d to_bearing = to.bearings[static_cast<size_t>(j)];
+    if (!refined_normalised.empty()) {
+      const Eigen::Vector3d ray(refined_normalised[k].x, refined_normalised[k].y, 1.0);
+      if (ray.allFinite()) to_bearing = ray.normalized();
+    }
+    matches->to.push_back(to_bearing);
   }
   *why << counts(from, to) << ", " << result->matches << " matches";
+  if (matched.refined > 0) *why << " (" << matched.refined << " refined at full resolution)";
   if (result->matches < settings.min_inliers) {
     result->message = "too few matches (" + why->str() + "; min_inliers " +
                       std::to_string(settings.min_inliers) +
@@ -224,6 +264,7 @@ SceneFeatures extractSceneFeatures(const cv::Mat& mono8, const CameraIntrinsics&
     features.descriptors.push_back(descriptors.row(order[k]));
     features.bearings.push_back(ray.normalized());
   }
+  features.image = mono8;
   return features;
 }
 
@@ -299,7 +340,7 @@ SceneRotation estimateSceneRotationNear(const SceneFeatures& from, const SceneFe
                                         const CameraIntrinsics& intrinsics,
                                         const Eigen::Matrix3d& R_from_to_near, double gate_px,
                                         const SceneRotationSettings& settings,
-                                        const SceneMatchIndices* matched) {
+                                        const SceneMatches* matched) {
   SceneRotation result;
   std::ostringstream why;
   scene_geometry::BearingMatches matches;
