@@ -13,14 +13,16 @@
 // between the two frames (a match no rigid motion explains).
 //
 // Usage: bench_scene_moving [room_robot|room_handheld] [seeds] [first seed] [camera rate, Hz]
-// (default room_robot 20 100 3). Prints one line per seed and the table of BENCHMARKS.md
-// ("Calibration without a board").
+// [default|fast|halved|fullrefined] (default room_robot 20 100 3 default; the features' profiles
+// at profileSettings). Prints one line per seed and the table of BENCHMARKS.md ("Calibration
+// without a board").
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
 #include <opencv2/features2d.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -67,7 +69,7 @@ std::vector<std::pair<int, int>> matchFeatures(const cv::Mat& a, const cv::Mat& 
   return out;
 }
 
-Share measureShare(const sim::SimulationRun& run) {
+Share measureShare(const sim::SimulationRun& run, const cia::SceneFeatureSettings& features) {
   const sim::SimulationConfig& c = run.config;
   const sim::RoomScene scene = sim::RoomScene::fromConfig(c);
   const sim::SceneRenderer renderer(sim::CameraModel::fromConfig(c), scene, c.supersample,
@@ -80,7 +82,7 @@ Share measureShare(const sim::SimulationRun& run) {
     const cv::Mat mono8 =
         sim::ImageRenderer::toMono8(renderer.renderAt(run.trajectory, t),
                                     c.noise_scale * c.pixel_noise_sigma, 7000 + times.size());
-    views.push_back(cia::extractSceneFeatures(mono8, intrinsics, cia::SceneFeatureSettings(), t));
+    views.push_back(cia::extractSceneFeatures(mono8, intrinsics, features, t));
     times.push_back(t);
   }
   Share share;
@@ -105,8 +107,25 @@ Share measureShare(const sim::SimulationRun& run) {
   return share;
 }
 
-Session solve(std::unique_ptr<sim::SimulationRun> run) {
-  cia::test::PipelineRun p = cia::test::feedPipeline(std::move(run), cia::PipelineSettings());
+/// The features' profile (argument 5): "default" (SIFT on the full image, 1500 features, the
+/// matches where they were detected), "fast" (SIFT on the image halved, 1000 features, each match
+/// refined at the full resolution), or the two halves of the difference: "halved" (fast, not
+/// refined) and "fullrefined" (default, refined). Empty settings: not a profile.
+std::optional<cia::PipelineSettings> profileSettings(const std::string& profile) {
+  cia::PipelineSettings settings;
+  if (profile == "default") return settings;
+  const bool halved = profile == "fast" || profile == "halved";
+  if (!halved && profile != "fullrefined") return std::nullopt;
+  if (halved) {
+    settings.scene_features.image_scale = 0.5;
+    settings.scene_features.max_features = 1000;
+  }
+  settings.scene_rotation.refine_matches = profile != "halved";
+  return settings;
+}
+
+Session solve(std::unique_ptr<sim::SimulationRun> run, const cia::PipelineSettings& settings) {
+  cia::test::PipelineRun p = cia::test::feedPipeline(std::move(run), settings);
   Session s;
   for (const cia::StationaryPose& pose : p.pipeline->poses()) {
     for (const cia::SceneLinkSummary& link : pose.scene_links) {
@@ -169,6 +188,16 @@ int main(int argc, char** argv) {
   const int seeds = argc > 2 ? std::atoi(argv[2]) : 20;
   const std::uint64_t first = argc > 3 ? std::strtoull(argv[3], nullptr, 10) : 100;
   const double rate_hz = argc > 4 ? std::atof(argv[4]) : 3.0;
+  const std::string profile = argc > 5 ? argv[5] : "default";
+  const std::optional<cia::PipelineSettings> chosen = profileSettings(profile);
+  if (!chosen) {
+    std::fprintf(stderr,
+                 "bench_scene_moving: profile %s is not one of default, fast, halved, "
+                 "fullrefined\n",
+                 profile.c_str());
+    return 2;
+  }
+  const cia::PipelineSettings& settings = *chosen;
   Column fixed, moving;
   Share share;
   for (int k = 0; k < seeds; ++k) {
@@ -182,14 +211,14 @@ int main(int argc, char** argv) {
     c.camera_rate_hz = rate_hz;
     c.moving_objects = true;
     auto with_moving = std::make_unique<sim::SimulationRun>(c);
-    const Share s = measureShare(*with_moving);
+    const Share s = measureShare(*with_moving, settings.scene_features);
     share.matches += s.matches;
     share.on_moving += s.on_moving;
     share.on_moved += s.on_moved;
     auto held = std::make_unique<sim::SimulationRun>(c);
     held->config.moving_objects = false;  // same run, the boxes held where they stand at t = 0
-    const Session a = solve(std::move(held));
-    const Session b = solve(std::move(with_moving));
+    const Session a = solve(std::move(held), settings);
+    const Session b = solve(std::move(with_moving), settings);
     fixed.add(a);
     moving.add(b);
     std::printf(

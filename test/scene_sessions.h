@@ -75,6 +75,20 @@ inline int sceneSeedCount(int default_count) {
   return n > 0 ? n : default_count;
 }
 
+/// CIA_SCENE_PROFILE=fast: the features' fast profile (SIFT on the image halved, 1000 features,
+/// each match refined at the full resolution; BENCHMARKS.md, "Natural-scene rotation"); unset:
+/// the defaults.
+inline PipelineSettings sceneProfileSettings() {
+  PipelineSettings settings;
+  const char* profile = std::getenv("CIA_SCENE_PROFILE");
+  if (profile && std::string(profile) == "fast") {
+    settings.scene_features.image_scale = 0.5;
+    settings.scene_features.max_features = 1000;
+    settings.scene_rotation.refine_matches = true;
+  }
+  return settings;
+}
+
 inline SceneOutcome runScene(const std::string& scenario, std::uint64_t seed,
                              bool texture_poor = false) {
   sim::SimulationConfig c;
@@ -84,7 +98,7 @@ inline SceneOutcome runScene(const std::string& scenario, std::uint64_t seed,
   sim::applyImuGrade(sim::ImuGrade::kConsumer, &c);
   // Each rest is rendered once (the harness caches it); frames only add noise draws.
   c.camera_rate_hz = 10.0;
-  PipelineRun run = runPipeline(c);
+  PipelineRun run = runPipeline(c, sceneProfileSettings());
   SceneOutcome out;
   const auto& poses = run.pipeline->poses();
   const auto& rests = run.run->trajectory.poses();

@@ -260,8 +260,9 @@ TEST(JointCameraLinks, TheGyrosConsensusChoosesANearPlanarViewsSolution) {
 
 // A near-planar view's two solutions closer than the gyro can resolve (0.15-0.3 deg, links precise
 // to 0.005 deg; the simulated hand-held room, seed 109, had two such links 0.08 and 0.24 deg off):
-// neither is swapped in, the link's covariance is widened to span both, and the estimate stays
-// consistent, its 1-sigma covering its error. Solutions degrees apart are still chosen.
+// neither is swapped in; where the gyro leans to the other, the link's covariance is widened to
+// span both; the estimate stays consistent, its 1-sigma covering its error. A far (3 deg) wrong
+// alternative never widens a link.
 TEST(JointCameraLinks, SolutionsTheGyroCannotTellApartWidenTheLink) {
   const JointSimulation sim =
       withCameraLinks(simulateJointProblem(JointSimulationOptions{}, 370), deg2rad(0.005), 31);
@@ -286,8 +287,9 @@ TEST(JointCameraLinks, SolutionsTheGyroCannotTellApartWidenTheLink) {
   std::printf("consensus: %d of %d links, residual scale %.3f deg, %d undecided\n",
               consensus.consensus, consensus.links_judged, consensus.residual_scale_deg,
               consensus.undecided);
-  // Links whose gyro rotation is off by more than the consensus' gate are left to the screening.
-  EXPECT_GE(consensus.undecided, static_cast<int>(close_by_design.size()) * 3 / 4);
+  // Widened: the close links whose other (true) solution the gyro's prediction lies nearer to
+  // (seeded: 2 of the 5 here); links beyond the consensus' gate are left to the screening.
+  EXPECT_GE(consensus.undecided, 2);
   int widened_links = 0;
   for (size_t j = 0; j < chosen.camera_links.size(); ++j) {
     const CameraLink& link = chosen.camera_links[j];

@@ -374,29 +374,40 @@ TEST(SceneRotation, RenderedViewsUnderPureRotation) {
   EXPECT_LT(error_deg, 0.05);
   EXPECT_LT(nees, kChi2Of3Sigma);
 
-  // The defaults detect on the image halved and refine each match at the full resolution. The
-  // same features with the matches where they were detected: within 3 sigma too, but further
-  // from the truth than the refined ones.
-  EXPECT_GE(r.refined_matches, r.matches * 9 / 10) << r.message;
-  SceneRotationSettings unrefined;
-  unrefined.refine_matches = false;
-  const SceneRotation r_unrefined =
-      estimateSceneRotation(from, to, intrinsics, std::nullopt, unrefined);
+  // The fast profile: SIFT on the image halved (1000 features), each match refined at the full
+  // resolution. The same features with the matches where they were detected: within 3 sigma too,
+  // but further from the truth than the refined ones.
+  SceneFeatureSettings halved;
+  halved.image_scale = 0.5;
+  halved.max_features = 1000;
+  const SceneFeatures from_halved = extractSceneFeatures(pair.from, intrinsics, halved, 1.0);
+  const SceneFeatures to_halved = extractSceneFeatures(pair.to, intrinsics, halved, 2.0);
+  SceneRotationSettings refine;
+  refine.refine_matches = true;
+  const SceneRotation r_refined =
+      estimateSceneRotation(from_halved, to_halved, intrinsics, std::nullopt, refine);
+  const SceneRotation r_unrefined = estimateSceneRotation(from_halved, to_halved, intrinsics,
+                                                          std::nullopt, SceneRotationSettings());
+  ASSERT_TRUE(r_refined.ok) << r_refined.message;
   ASSERT_TRUE(r_unrefined.ok) << r_unrefined.message;
-  std::printf("not refined: %s; error %.4f deg, normalised error %.2f\n",
-              r_unrefined.message.c_str(), errorDeg(r_unrefined, pair.R_from_to),
-              normalisedError(r_unrefined, pair.R_from_to));
+  for (const SceneRotation* x : {&r_refined, &r_unrefined}) {
+    std::printf("image_scale 0.5, %s: %s; error %.4f deg, normalised error %.2f\n",
+                x == &r_refined ? "refined" : "not refined", x->message.c_str(),
+                errorDeg(*x, pair.R_from_to), normalisedError(*x, pair.R_from_to));
+    EXPECT_LT(normalisedError(*x, pair.R_from_to), kChi2Of3Sigma);
+  }
+  EXPECT_GE(r_refined.refined_matches, r_refined.matches * 9 / 10) << r_refined.message;
   EXPECT_EQ(r_unrefined.refined_matches, 0);
-  EXPECT_LT(normalisedError(r_unrefined, pair.R_from_to), kChi2Of3Sigma);
-  EXPECT_LT(error_deg, errorDeg(r_unrefined, pair.R_from_to));
+  EXPECT_LT(errorDeg(r_refined, pair.R_from_to), errorDeg(r_unrefined, pair.R_from_to));
 
   // An exposure jump between the views (gain 1.25, offset -20): the refinement matches the
-  // brightness first, so it still refines nearly every match, as precisely.
+  // brightness first, so it still refines nearly every match, as precisely. (Measured with gain
+  // 1.4, offset -30, where much of the texture clips: normalised error 13.9, at the bound.)
   cv::Mat brighter;
   pair.to.convertTo(brighter, CV_8UC1, 1.25, -20.0);
   const SceneRotation r_exposed =
-      estimateSceneRotation(from, extractSceneFeatures(brighter, intrinsics, feature_settings, 2.0),
-                            intrinsics, std::nullopt, SceneRotationSettings());
+      estimateSceneRotation(from_halved, extractSceneFeatures(brighter, intrinsics, halved, 2.0),
+                            intrinsics, std::nullopt, refine);
   ASSERT_TRUE(r_exposed.ok) << r_exposed.message;
   std::printf("exposure jump: %s; error %.4f deg, normalised error %.2f\n",
               r_exposed.message.c_str(), errorDeg(r_exposed, pair.R_from_to),
@@ -404,20 +415,6 @@ TEST(SceneRotation, RenderedViewsUnderPureRotation) {
   EXPECT_GE(r_exposed.refined_matches, r_exposed.matches * 9 / 10);
   EXPECT_LT(errorDeg(r_exposed, pair.R_from_to), errorDeg(r_unrefined, pair.R_from_to));
   EXPECT_LT(normalisedError(r_exposed, pair.R_from_to), kChi2Of3Sigma);
-
-  // SIFT on the full image (image_scale 1, 1500 features): still within 3 sigma.
-  SceneFeatureSettings full;
-  full.image_scale = 1.0;
-  full.max_features = 1500;
-  const SceneRotation r_full =
-      estimateSceneRotation(extractSceneFeatures(pair.from, intrinsics, full, 1.0),
-                            extractSceneFeatures(pair.to, intrinsics, full, 2.0), intrinsics,
-                            std::nullopt, SceneRotationSettings());
-  ASSERT_TRUE(r_full.ok) << r_full.message;
-  std::printf("image_scale 1: %s; error %.4f deg, normalised error %.2f\n", r_full.message.c_str(),
-              errorDeg(r_full, pair.R_from_to), normalisedError(r_full, pair.R_from_to));
-  EXPECT_LT(errorDeg(r_full, pair.R_from_to), 0.05);
-  EXPECT_LT(normalisedError(r_full, pair.R_from_to), kChi2Of3Sigma);
 
   // A prediction 10 deg off fails the pair; a close one passes.
   SceneRotationSettings settings;

@@ -16,11 +16,12 @@
 //  2. M fitted by least squares to the consensus links' nearest solutions, their residual's robust
 //     scale measured, and the nearest solutions chosen again (three rounds);
 //  3. a link is given its other solution when that one lies within kSwapSigmas of the scale and
-//     the measured one beyond it; when both lie within it, the gyro cannot tell them apart and the
-//     link's covariance is widened to span them (CameraLink::undecided_rad2). Measured on the
-//     simulated hand-held room (seed 109): two links held the wrong one of two solutions 0.08 and
-//     0.24 deg apart at a 1-sigma of 0.001-0.002 deg; the joint estimate bent the IMU's states to
-//     fit them (chi2/dof 1.69, inconsistent).
+//     the measured one beyond it. When the other solution is the nearer but the measured one also
+//     lies within, the gyro leans to the other without telling them apart: the link's covariance
+//     is widened to span both (CameraLink::undecided_rad2). Measured on the simulated hand-held
+//     room with the fast feature profile (seed 109): two links held the wrong one of two
+//     solutions 0.08 and 0.24 deg apart at a 1-sigma of 0.001-0.002 deg, and the joint estimate
+//     bent the IMU's states to fit them (chi2/dof 1.69, inconsistent).
 // Links across gyro chains, windows with fewer than kMinConsensusLinks links in one chain, or no
 // consensus of them, are left as they are (the joint estimate's screening still judges them).
 #pragma once

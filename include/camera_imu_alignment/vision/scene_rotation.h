@@ -23,7 +23,7 @@
 namespace camera_imu_alignment {
 
 struct SceneFeatureSettings {
-  int max_features = 1000;  ///< strongest SIFT keypoints kept per view
+  int max_features = 1500;  ///< strongest SIFT keypoints kept per view
   int octave_layers = 3;    ///< SIFT layers per octave (fewer: faster, fewer keypoints)
   /// SIFT's contrast threshold (OpenCV's default; OpenCV divides it by octave_layers): lower finds
   /// keypoints in fainter texture (a plain wall, a table), weaker ones.
@@ -31,9 +31,10 @@ struct SceneFeatureSettings {
   /// The image is resized by this factor (0 < image_scale <= 1, area averaging) before SIFT;
   /// keypoints and bearings are in the full image's pixels. 0.5 costs less than half the time of
   /// 1 (SIFT's first octave works at twice the resolution it is given) and drops the finest
-  /// scale; the matches' refinement at full resolution (SceneRotationSettings::refine_matches)
-  /// gives the precision back (BENCHMARKS.md, "Natural-scene rotation").
-  double image_scale = 0.5;
+  /// scale. With 1000 features and SceneRotationSettings::refine_matches (the fast profile) it
+  /// meets the cost targets and is more accurate hand-held, less so where a robot drove between
+  /// views with objects moved (BENCHMARKS.md, "Natural-scene rotation").
+  double image_scale = 1.0;
 };
 
 /// The features of one view (a rest's sharpest frame).
@@ -80,8 +81,9 @@ struct SceneRotationSettings {
   /// Each match's position in the `to` view refined at the full resolution: the `to` image warped
   /// into the `from` view by the matches' homography, then Lucas-Kanade on a window around the
   /// `from` keypoint (both views' images needed). What SIFT at a reduced image_scale loses in
-  /// localisation, at a fraction of a full-resolution SIFT's cost.
-  bool refine_matches = true;
+  /// localisation, at a fraction of a full-resolution SIFT's cost. Off by default: on the robot's
+  /// stops with moved objects it made the estimate worse (BENCHMARKS.md).
+  bool refine_matches = false;
   /// A refinement that moves a match further than this (pixels of the full image) from where it was
   /// detected has locked onto other texture: the match keeps its detected position.
   double refine_max_shift_px = 2.0;

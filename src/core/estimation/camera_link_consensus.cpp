@@ -119,15 +119,17 @@ Eigen::Matrix3d fitMap(const std::vector<JudgedLink>& links, const std::vector<i
   return B * A.inverse();
 }
 
-/// A link whose measured solution and another both lie within `gate` of the prediction M theta:
-/// the gyro cannot tell which is right, so the link's covariance spans them (each such solution's
-/// difference d from the measured one, as d d^T, added to the link's and the alternatives'
-/// covariances; CameraLink::undecided_rad2).
+/// A link whose measured solution and a nearer one both lie within `gate` of the prediction
+/// M theta: the gyro cannot tell which is right, so the link's covariance spans them (each such
+/// solution's difference d from the measured one, as d d^T, added to the link's and the
+/// alternatives' covariances; CameraLink::undecided_rad2).
 void keepUndecided(const JudgedLink& l, const Eigen::Matrix3d& M, double gate, CameraLink* link) {
   const Eigen::Vector3d predicted = M * l.theta_imu;
+  const double measured = (predicted - l.phi[0]).norm();
   Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
   for (std::size_t c = 1; c < l.R_cam.size(); ++c) {
-    if ((predicted - l.phi[c]).norm() >= gate) continue;
+    const double distance = (predicted - l.phi[c]).norm();
+    if (distance >= gate || distance >= measured) continue;
     const Eigen::Vector3d d = logSO3(l.R_cam[0].transpose() * l.R_cam[c]);  // `to` camera axes
     if (d.allFinite()) spread += d * d.transpose();
   }
@@ -245,7 +247,7 @@ CameraLinkConsensus chooseCameraLinkSolutions(JointProblem* problem) {
     const JudgedLink& l = links[k];
     const double measured = (M * l.theta_imu - l.phi[0]).norm();
     CameraLink& link = problem->camera_links[l.index];
-    if (use[k] && measured < kSwapSigmas * sigma) {
+    if (use[k] && chosen[k] != 0 && measured < kSwapSigmas * sigma) {
       keepUndecided(l, M, kSwapSigmas * sigma, &link);
       if (link.undecided_rad2.trace() > 0) ++out.undecided;
     }
