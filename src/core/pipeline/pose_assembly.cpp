@@ -378,7 +378,8 @@ namespace {
 
 /// What became of the window's natural-scene rotations, as one parenthetical clause (empty when
 /// nothing did): those taken as a near-planar view's other solution, by the gyro's consensus
-/// (WindowSnapshot::link_consensus) and by the joint estimate's screening; those fitted again with
+/// (WindowSnapshot::link_consensus) and by the joint estimate's screening; those widened by the
+/// consensus (CameraLinkConsensus::undecided); those fitted again with
 /// the rotation held (JointResult::camera_links_refitted); those left out by the screening.
 std::string sceneLinkNotes(const WindowSnapshot& window, const JointResult& joint) {
   const auto taken = [](const std::vector<int>& used) {
@@ -393,6 +394,10 @@ std::string sceneLinkNotes(const WindowSnapshot& window, const JointResult& join
       << " by the gyro's consensus of " << window.link_consensus.consensus << " of "
       << window.link_consensus.links_judged << ", " << by_screening << " by the screening";
     notes.push_back(s.str());
+  }
+  if (window.link_consensus.undecided > 0) {
+    notes.push_back(std::to_string(window.link_consensus.undecided) +
+                    " widened to span two solutions the gyro could not tell apart");
   }
   if (!joint.camera_links_refitted.empty()) {
     const std::size_t two = joint.camera_links_second_motion.size();
