@@ -116,10 +116,7 @@ std::optional<cia::PipelineSettings> profileSettings(const std::string& profile)
   if (profile == "default") return settings;
   const bool halved = profile == "fast" || profile == "halved";
   if (!halved && profile != "fullrefined") return std::nullopt;
-  if (halved) {
-    settings.scene_features.image_scale = 0.5;
-    settings.scene_features.max_features = 1000;
-  }
+  if (halved) useFastSceneProfile(&settings.scene_features, &settings.scene_rotation);
   settings.scene_rotation.refine_matches = profile != "halved";
   return settings;
 }

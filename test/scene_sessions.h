@@ -82,9 +82,7 @@ inline PipelineSettings sceneProfileSettings() {
   PipelineSettings settings;
   const char* profile = std::getenv("CIA_SCENE_PROFILE");
   if (profile && std::string(profile) == "fast") {
-    settings.scene_features.image_scale = 0.5;
-    settings.scene_features.max_features = 1000;
-    settings.scene_rotation.refine_matches = true;
+    useFastSceneProfile(&settings.scene_features, &settings.scene_rotation);
   }
   return settings;
 }

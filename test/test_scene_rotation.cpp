@@ -378,12 +378,12 @@ TEST(SceneRotation, RenderedViewsUnderPureRotation) {
   // resolution. The same features with the matches where they were detected: within 3 sigma too,
   // but further from the truth than the refined ones.
   SceneFeatureSettings halved;
-  halved.image_scale = 0.5;
-  halved.max_features = 1000;
+  SceneRotationSettings refine;
+  useFastSceneProfile(&halved, &refine);
+  ASSERT_EQ(halved.image_scale, 0.5);
+  ASSERT_TRUE(refine.refine_matches);
   const SceneFeatures from_halved = extractSceneFeatures(pair.from, intrinsics, halved, 1.0);
   const SceneFeatures to_halved = extractSceneFeatures(pair.to, intrinsics, halved, 2.0);
-  SceneRotationSettings refine;
-  refine.refine_matches = true;
   const SceneRotation r_refined =
       estimateSceneRotation(from_halved, to_halved, intrinsics, std::nullopt, refine);
   const SceneRotation r_unrefined = estimateSceneRotation(from_halved, to_halved, intrinsics,

@@ -89,6 +89,12 @@ struct SceneRotationSettings {
   double refine_max_shift_px = 2.0;
 };
 
+/// The fast profile: SIFT on the image halved with 1000 features, each match refined at the full
+/// resolution (49 ms per view, 28 ms per pair on one core: the cost targets). Not the
+/// default: worse at a robot's stops with objects moved between them (BENCHMARKS.md,
+/// "Natural-scene rotation").
+void useFastSceneProfile(SceneFeatureSettings* features, SceneRotationSettings* rotation);
+
 /// Matches between two views' features.
 struct SceneMatches {
   std::vector<std::pair<int, int>> indices;  ///< (index into `from`, index into `to`)

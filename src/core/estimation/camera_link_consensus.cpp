@@ -119,13 +119,13 @@ Eigen::Matrix3d fitMap(const std::vector<JudgedLink>& links, const std::vector<i
   return B * A.inverse();
 }
 
-/// A link whose measured solution and a nearer one both lie within `gate` of the prediction
-/// M theta: the gyro cannot tell which is right, so the link's covariance spans them (each such
-/// solution's difference d from the measured one, as d d^T, added to the link's and the
-/// alternatives' covariances; CameraLink::undecided_rad2).
-void keepUndecided(const JudgedLink& l, const Eigen::Matrix3d& M, double gate, CameraLink* link) {
-  const Eigen::Vector3d predicted = M * l.theta_imu;
-  const double measured = (predicted - l.phi[0]).norm();
+/// A link whose measured solution (`measured` rad from the prediction M theta, within `gate`) and
+/// a nearer one both lie within `gate` of `predicted`: the gyro cannot tell which is right, so the
+/// link's covariance spans them (each such solution's difference d from the measured one, as
+/// d d^T, added to the link's and the alternatives' covariances; CameraLink::undecided_rad2).
+/// True when the link was widened.
+bool widenUndecided(const JudgedLink& l, const Eigen::Vector3d& predicted, double measured,
+                    double gate, CameraLink* link) {
   Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
   for (std::size_t c = 1; c < l.R_cam.size(); ++c) {
     const double distance = (predicted - l.phi[c]).norm();
@@ -133,10 +133,11 @@ void keepUndecided(const JudgedLink& l, const Eigen::Matrix3d& M, double gate, C
     const Eigen::Vector3d d = logSO3(l.R_cam[0].transpose() * l.R_cam[c]);  // `to` camera axes
     if (d.allFinite()) spread += d * d.transpose();
   }
-  if (!(spread.trace() > 0)) return;
+  if (!(spread.trace() > 0)) return false;
   link->undecided_rad2 = spread;
   link->cov_rad2 += spread;
   for (CameraLink::Alternative& a : link->alternatives) a.cov_rad2 += spread;
+  return true;
 }
 
 }  // namespace
@@ -242,16 +243,18 @@ CameraLinkConsensus chooseCameraLinkSolutions(JointProblem* problem) {
   out.residual_scale_deg = sigma / kDegToRad;
 
   // 3. The swaps, and the solutions the gyro cannot choose between.
+  const double gate = kSwapSigmas * sigma;
   for (std::size_t k = 0; k < links.size(); ++k) {
     out.consensus += use[k];
+    if (chosen[k] == 0 || !use[k]) continue;
     const JudgedLink& l = links[k];
-    const double measured = (M * l.theta_imu - l.phi[0]).norm();
+    const Eigen::Vector3d predicted = M * l.theta_imu;
+    const double measured = (predicted - l.phi[0]).norm();
     CameraLink& link = problem->camera_links[l.index];
-    if (use[k] && chosen[k] != 0 && measured < kSwapSigmas * sigma) {
-      keepUndecided(l, M, kSwapSigmas * sigma, &link);
-      if (link.undecided_rad2.trace() > 0) ++out.undecided;
+    if (measured < gate) {  // another solution is nearer, but the measured one fits too
+      out.undecided += widenUndecided(l, predicted, measured, gate, &link);
+      continue;
     }
-    if (chosen[k] == 0 || !use[k] || measured < kSwapSigmas * sigma) continue;
     const int a = chosen[k] - 1;
     std::swap(link.R_from_to, link.alternatives[a].R_from_to);
     std::swap(link.cov_rad2, link.alternatives[a].cov_rad2);

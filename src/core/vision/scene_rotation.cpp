@@ -206,6 +206,12 @@ void takeFit(const scene_geometry::ModelFit& fit, bool rotation_only,
 
 }  // namespace
 
+void useFastSceneProfile(SceneFeatureSettings* features, SceneRotationSettings* rotation) {
+  features->image_scale = 0.5;
+  features->max_features = 1000;
+  rotation->refine_matches = true;
+}
+
 double imageSharpness(const cv::Mat& mono8) {
   if (mono8.empty() || mono8.type() != CV_8UC1) return 0;
   cv::Mat laplacian;
