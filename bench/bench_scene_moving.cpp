@@ -116,7 +116,9 @@ std::optional<cia::PipelineSettings> profileSettings(const std::string& profile)
   if (profile == "default") return settings;
   const bool halved = profile == "fast" || profile == "halved";
   if (!halved && profile != "fullrefined") return std::nullopt;
-  if (halved) useFastSceneProfile(&settings.scene_features, &settings.scene_rotation);
+  if (halved)
+    cia::useSceneProfile(cia::SceneProfile::kFast, &settings.scene_features,
+                         &settings.scene_rotation);
   settings.scene_rotation.refine_matches = profile != "halved";
   return settings;
 }

@@ -82,7 +82,7 @@ inline PipelineSettings sceneProfileSettings() {
   PipelineSettings settings;
   const char* profile = std::getenv("CIA_SCENE_PROFILE");
   if (profile && std::string(profile) == "fast") {
-    useFastSceneProfile(&settings.scene_features, &settings.scene_rotation);
+    useSceneProfile(SceneProfile::kFast, &settings.scene_features, &settings.scene_rotation);
   }
   return settings;
 }

@@ -421,6 +421,7 @@ TEST(CalibrateBag, BadUsageAndInputsExitTwoNamingTheCulprit) {
       {"--bag " + bag + " --target " + target + " --imu-topic camera/image_raw",
        "sensor_msgs/Image"},
       {"--bag " + bag + " --target " + target + " --method best", "--method"},
+      {"--bag " + bag + " --scene-profile quick", "--scene-profile quick: must be full or fast"},
       {"--bag " + bag + " --target " + target + " --config " + target, "unknown key"},
       {"--bag " + bag + " --target " + target + " --config " + typo,
        typo + ": unknown key 'min_pose' (see config/default.yaml); did you mean 'min_poses'?"},
@@ -437,8 +438,16 @@ TEST(CalibrateBag, BadUsageAndInputsExitTwoNamingTheCulprit) {
   // pair here), said as such.
   const test::ToolRun scene = test::runTool(kCalibrate + " --quiet --bag " + bag);
   EXPECT_NE(scene.exit_code, 0);
-  EXPECT_NE(scene.err.find("no --target: the natural scene's features"), std::string::npos)
+  EXPECT_NE(scene.err.find("no --target: the natural scene's features (scene_profile full)"),
+            std::string::npos)
       << scene.err;
+  // The fast profile, asked for by option or by the setting, is the one used and said so.
+  const std::string fast = temp("fast.yaml");
+  std::ofstream(fast) << "scene_profile: fast\n";
+  for (const std::string& how : {std::string("--scene-profile fast"), "--config " + fast}) {
+    const test::ToolRun r = test::runTool(kCalibrate + " --quiet --bag " + bag + " " + how);
+    EXPECT_NE(r.err.find("(scene_profile fast)"), std::string::npos) << how << "\n" << r.err;
+  }
   removeBag(bag);
 }
 

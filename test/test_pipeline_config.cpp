@@ -63,6 +63,7 @@ PipelineSettings scrambled() {
   s.missed_frame_interval_s = 17;
   s.frame_margin_s = 7;
   s.max_camera_spread_deg = 7;
+  useSceneProfile(SceneProfile::kFast, &s.scene_features, &s.scene_rotation);
   s.frame_queue_s = 7;
   s.window_poses = 77;
   s.min_poses_to_solve = 7;
@@ -115,6 +116,9 @@ void expectDefaults(const PipelineSettings& s) {
   EXPECT_EQ(s.missed_frame_interval_s, d.missed_frame_interval_s);
   EXPECT_EQ(s.frame_margin_s, d.frame_margin_s);
   EXPECT_EQ(s.max_camera_spread_deg, d.max_camera_spread_deg);
+  EXPECT_EQ(s.scene_features.image_scale, d.scene_features.image_scale);
+  EXPECT_EQ(s.scene_features.max_features, d.scene_features.max_features);
+  EXPECT_EQ(s.scene_rotation.refine_matches, d.scene_rotation.refine_matches);
   EXPECT_EQ(s.frame_queue_s, d.frame_queue_s);
   EXPECT_EQ(s.window_poses, d.window_poses);
   EXPECT_EQ(s.min_poses_to_solve, d.min_poses_to_solve);
@@ -204,6 +208,26 @@ TEST(PipelineConfig, BadFilesAreRefusedNamingTheKey) {
   expectRefused("accel_weight: 1.5\n", "accel_weight");
   expectRefused("- a list\n", "map");
   expectRefused("frame_margin_s: .nan\n", "frame_margin_s");
+  expectRefused("scene_profile: quick\n", "scene_profile = quick: must be 'full' or 'fast'");
+}
+
+TEST(PipelineConfig, TheSceneProfileSetsItsFeatureSettingsAndReadsBackAsItsName) {
+  PipelineSettings s;
+  EXPECT_EQ(findKey(pipelineKeys(), "scene_profile")->text(s), "full");
+  parsePipelineConfig("scene_profile: fast\n", "params", &s);
+  EXPECT_EQ(s.scene_features.image_scale, 0.5);
+  EXPECT_EQ(s.scene_features.max_features, 1000);
+  EXPECT_TRUE(s.scene_rotation.refine_matches);
+  EXPECT_EQ(findKey(pipelineKeys(), "scene_profile")->text(s), "fast");
+  // Back to full: every setting the fast profile changed returns to its default.
+  parsePipelineConfig("scene_profile: full\n", "params", &s);
+  const PipelineSettings d;
+  EXPECT_EQ(s.scene_features.image_scale, d.scene_features.image_scale);
+  EXPECT_EQ(s.scene_features.max_features, d.scene_features.max_features);
+  EXPECT_EQ(s.scene_rotation.refine_matches, d.scene_rotation.refine_matches);
+  // Set in code to neither: said so.
+  s.scene_features.image_scale = 0.75;
+  EXPECT_EQ(findKey(pipelineKeys(), "scene_profile")->text(s), "custom");
 }
 
 TEST(WrapperSettings, BadParametersAreRefusedNamingThem) {

@@ -379,7 +379,7 @@ TEST(SceneRotation, RenderedViewsUnderPureRotation) {
   // but further from the truth than the refined ones.
   SceneFeatureSettings halved;
   SceneRotationSettings refine;
-  useFastSceneProfile(&halved, &refine);
+  useSceneProfile(SceneProfile::kFast, &halved, &refine);
   ASSERT_EQ(halved.image_scale, 0.5);
   ASSERT_TRUE(refine.refine_matches);
   const SceneFeatures from_halved = extractSceneFeatures(pair.from, intrinsics, halved, 1.0);

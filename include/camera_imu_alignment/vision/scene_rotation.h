@@ -89,11 +89,27 @@ struct SceneRotationSettings {
   double refine_max_shift_px = 2.0;
 };
 
-/// The fast profile: SIFT on the image halved with 1000 features, each match refined at the full
-/// resolution (49 ms per view, 28 ms per pair on one core: the issue's cost targets). Not the
-/// default: worse at a robot's stops with objects moved between them (BENCHMARKS.md,
-/// "Natural-scene rotation").
-void useFastSceneProfile(SceneFeatureSettings* features, SceneRotationSettings* rotation);
+/// The natural scene's feature profiles (the setting scene_profile).
+enum class SceneProfile {
+  kFull,  ///< the defaults: SIFT on the full image, 1500 features, matches where detected
+  /// SIFT on the image halved with 1000 features, each match refined at the full resolution
+  /// (49 ms per view, 28 ms per pair on one core: the issue's cost targets). Not the default:
+  /// worse at a robot's stops with objects moved between them (BENCHMARKS.md, "Natural-scene
+  /// rotation").
+  kFast,
+  kCustom,  ///< settings that are neither (sceneProfileOf only)
+};
+/// "full", "fast", "custom".
+const char* toString(SceneProfile profile);
+/// "full" or "fast" (not "custom"); false on any other word.
+bool parseSceneProfile(const std::string& word, SceneProfile* profile);
+/// Sets the settings that make up `profile` (image_scale, max_features, refine_matches); the
+/// others keep their values. kCustom changes nothing.
+void useSceneProfile(SceneProfile profile, SceneFeatureSettings* features,
+                     SceneRotationSettings* rotation);
+/// The profile the settings are, or kCustom.
+SceneProfile sceneProfileOf(const SceneFeatureSettings& features,
+                            const SceneRotationSettings& rotation);
 
 /// Matches between two views' features.
 struct SceneMatches {

@@ -50,6 +50,32 @@ Key numberList(const std::string& name, Get get, Set set, Valid valid, const std
           false};
 }
 
+/// scene_profile: sets the natural scene's feature settings that make up a profile; reads back
+/// as the profile the settings are ("custom" when set in code to neither).
+Key sceneProfileKey() {
+  const std::string allowed = wordsText({"full", "fast"});
+  return {"scene_profile",
+          "",
+          "without a target: full (SIFT on the full image) or fast (the image halved, each match "
+          "refined: about 50 ms per rest, 30 per pair; less accurate where a robot drove between "
+          "stops with objects moved)",
+          allowed,
+          [](const YAML::Node& node, PipelineSettings* s) {
+            SceneProfile profile = SceneProfile::kFull;
+            if (!parseSceneProfile(node.as<std::string>(), &profile)) {
+              throw YAML::Exception(node.Mark(), "unknown word");
+            }
+            useSceneProfile(profile, &s->scene_features, &s->scene_rotation);
+          },
+          "",
+          [](const PipelineSettings&) { return true; },
+          [](const PipelineSettings& s) {
+            return std::string(toString(sceneProfileOf(s.scene_features, s.scene_rotation)));
+          },
+          std::nullopt,
+          false};
+}
+
 const std::vector<Key>& keys() {
   const SettingRange positive = above(0.0);
   const SettingRange non_negative = atLeast(0.0);
@@ -182,6 +208,7 @@ const std::vector<Key>& keys() {
                      "s", "after 3 failed detections in a row: the interval between attempts"),
       number<double>("frame_margin_s", CIA_MEMBER(frame_margin_s), non_negative, "s",
                      "frames this close to a rest's ends are not used"),
+      sceneProfileKey(),
       number<double>("max_camera_spread_deg", CIA_MEMBER(max_camera_spread_deg), positive, "deg",
                      "camera orientation scatter within a rest"),
       number<double>("frame_queue_s", CIA_MEMBER(frame_queue_s), positive, "s",

@@ -86,8 +86,8 @@ CalibrationPipeline::Impl::Impl(const TargetDescription& target_, const Pipeline
       symmetries(detector.symmetries()),
       stationary(settings_.stationary),
       disturbance(settings_.disturbance),
-      natural_scene(target_.numPoints() == 0),
-      window(settings_.window_poses) {}
+      window(settings_.window_poses),
+      natural_scene(target_.numPoints() == 0) {}
 
 void CalibrationPipeline::Impl::reject(RejectReason reason, InputStream stream,
                                        const std::string& detail) {

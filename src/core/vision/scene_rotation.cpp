@@ -206,10 +206,50 @@ void takeFit(const scene_geometry::ModelFit& fit, bool rotation_only,
 
 }  // namespace
 
-void useFastSceneProfile(SceneFeatureSettings* features, SceneRotationSettings* rotation) {
-  features->image_scale = 0.5;
-  features->max_features = 1000;
-  rotation->refine_matches = true;
+const char* toString(SceneProfile profile) {
+  switch (profile) {
+    case SceneProfile::kFull:
+      return "full";
+    case SceneProfile::kFast:
+      return "fast";
+    case SceneProfile::kCustom:
+      break;
+  }
+  return "custom";
+}
+
+bool parseSceneProfile(const std::string& word, SceneProfile* profile) {
+  for (SceneProfile p : {SceneProfile::kFull, SceneProfile::kFast}) {
+    if (word == toString(p)) {
+      *profile = p;
+      return true;
+    }
+  }
+  return false;
+}
+
+void useSceneProfile(SceneProfile profile, SceneFeatureSettings* features,
+                     SceneRotationSettings* rotation) {
+  if (profile == SceneProfile::kCustom) return;
+  const bool fast = profile == SceneProfile::kFast;
+  const SceneFeatureSettings full;
+  features->image_scale = fast ? 0.5 : full.image_scale;
+  features->max_features = fast ? 1000 : full.max_features;
+  rotation->refine_matches = fast;
+}
+
+SceneProfile sceneProfileOf(const SceneFeatureSettings& features,
+                            const SceneRotationSettings& rotation) {
+  for (SceneProfile p : {SceneProfile::kFull, SceneProfile::kFast}) {
+    SceneFeatureSettings f = features;
+    SceneRotationSettings r = rotation;
+    useSceneProfile(p, &f, &r);
+    if (f.image_scale == features.image_scale && f.max_features == features.max_features &&
+        r.refine_matches == rotation.refine_matches) {
+      return p;
+    }
+  }
+  return SceneProfile::kCustom;
 }
 
 double imageSharpness(const cv::Mat& mono8) {
