@@ -113,7 +113,7 @@ Share measureShare(const sim::SimulationRun& run, const cia::SceneFeatureSetting
 /// refined) and "fullrefined" (default, refined). Empty settings: not a profile.
 std::optional<cia::PipelineSettings> profileSettings(const std::string& profile) {
   cia::PipelineSettings settings;
-  if (profile == "default") return settings;
+  if (profile == "default" || profile == "full") return settings;
   const bool halved = profile == "fast" || profile == "halved";
   if (!halved && profile != "fullrefined") return std::nullopt;
   if (halved)
@@ -155,6 +155,44 @@ Session solve(std::unique_ptr<sim::SimulationRun> run, const cia::PipelineSettin
   for (const cia::CameraLink& link : window.joint.camera_links) {
     ++s.window_links;
     s.links_beyond += beyond(link);
+  }
+  // CIA_BENCH_LINKS=1: each window link against the truth, as measured and fitted again with the
+  // rotation held near the estimate's (a diagnosis, not part of the table).
+  if (std::getenv("CIA_BENCH_LINKS") && result.joint && window.scene_link_refit &&
+      result.joint->camera_orientation_fit.size() == window.joint.poses.size()) {
+    const auto describe = [&](const char* what, const cia::CameraLink& link,
+                              const Eigen::Matrix3d& R, const Eigen::Matrix3d& cov) {
+      const Eigen::Matrix3d R_true =
+          trueCamera(link.from_pose).transpose() * trueCamera(link.to_pose);
+      const Eigen::Vector3d e = cia::logSO3(R_true.transpose() * R);
+      std::printf(" %s %.3f deg (sigma %.3f, chi2 %.1f)", what, cia::rad2deg(e.norm()),
+                  cia::rad2deg(std::sqrt(cov.trace())), e.dot(cov.inverse() * e));
+    };
+    for (size_t j = 0; j < window.joint.camera_links.size(); ++j) {
+      const cia::CameraLink& link = window.joint.camera_links[j];
+      const auto& fit = result.joint->camera_orientation_fit;
+      const Eigen::Matrix3d R_fit = fit[static_cast<size_t>(link.from_pose)].transpose() *
+                                    fit[static_cast<size_t>(link.to_pose)];
+      std::printf("  link %zu (%d->%d):", j, link.from_pose, link.to_pose);
+      describe("measured", link, link.R_from_to, link.cov_rad2);
+      const std::optional<cia::SceneRotation> again =
+          window.scene_link_refit(static_cast<int>(j), R_fit);
+      if (again && again->ok) {
+        describe("held", link, again->R_from_to, again->cov_rad2 + link.undecided_rad2);
+        std::printf(" %s, %d of %d inliers, %d second motion",
+                    again->model == cia::SceneMotionModel::kGeneral ? "general" : "rotation",
+                    again->inliers, again->matches, again->second_motion_inliers);
+      }
+      const Eigen::Matrix3d R_true =
+          trueCamera(link.from_pose).transpose() * trueCamera(link.to_pose);
+      const std::optional<cia::SceneRotation> at_truth =
+          window.scene_link_refit(static_cast<int>(j), R_true);
+      if (at_truth && at_truth->ok) {
+        describe("| near the truth", link, at_truth->R_from_to, at_truth->cov_rad2);
+        std::printf(" %d second motion", at_truth->second_motion_inliers);
+      }
+      std::printf("\n");
+    }
   }
   s.solved = result.status == cia::SolveStatus::kOk;
   if (!s.solved) return s;
