@@ -93,6 +93,11 @@ inline SceneOutcome runScene(const std::string& scenario, std::uint64_t seed,
   c.seed = seed;
   EXPECT_TRUE(sim::applyScenario(scenario, &c));
   c.texture_poor = texture_poor;
+  // CIA_SCENE_ROBOT_TILT=MIN,MAX (deg): the robot's tilt at its stops (default 5,20), to measure
+  // what more tilt gives.
+  if (const char* tilt = std::getenv("CIA_SCENE_ROBOT_TILT")) {
+    std::sscanf(tilt, "%lf,%lf", &c.robot_min_tilt_deg, &c.robot_max_tilt_deg);
+  }
   sim::applyImuGrade(sim::ImuGrade::kConsumer, &c);
   // Each rest is rendered once (the harness caches it); frames only add noise draws.
   c.camera_rate_hz = 10.0;

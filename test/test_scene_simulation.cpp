@@ -173,6 +173,10 @@ TEST(SceneTrajectory, RobotStopsMeetTheirSpecification) {
   for (std::uint64_t seed = 1; seed <= 10; ++seed) {
     sim::SimulationConfig config = roomConfig("room_robot", seed);
     config.moving_objects = seed > 5;  // the boxes' slides leave less room to drive
+    if (seed > 8) {                    // steeper ground (simulate_bag --robot-tilt-deg 20,35)
+      config.robot_min_tilt_deg = 20.0;
+      config.robot_max_tilt_deg = 35.0;
+    }
     const sim::Trajectory trajectory(config);
     const sim::RoomScene scene = sim::RoomScene::fromConfig(config);
     const sim::CameraModel cam = sim::CameraModel::fromConfig(config);
@@ -190,8 +194,8 @@ TEST(SceneTrajectory, RobotStopsMeetTheirSpecification) {
       // camera the same height above it along the base's z at every stop.
       const Eigen::Matrix3d R_world_base = s.R_world_cam * R_base_cam.transpose();
       const double tilt_deg = toDeg(std::acos(R_world_base(2, 2)));
-      EXPECT_GE(tilt_deg, 5.0 - 1e-6);
-      EXPECT_LE(tilt_deg, 20.0 + 1e-6);
+      EXPECT_GE(tilt_deg, config.robot_min_tilt_deg - 1e-6);
+      EXPECT_LE(tilt_deg, config.robot_max_tilt_deg + 1e-6);
       const double h = s.p_world_cam.z() / R_world_base(2, 2);
       if (height < 0.0) height = h;
       EXPECT_NEAR(h, height, 1e-9);
@@ -199,8 +203,10 @@ TEST(SceneTrajectory, RobotStopsMeetTheirSpecification) {
       EXPECT_LE(h, 0.5);
       const Eigen::Vector3d base = s.p_world_cam - R_world_base * Eigen::Vector3d(0, 0, h);
       EXPECT_TRUE(scene.floorPointFree(base.x(), base.y(), 0.39));
-      // Roughly horizontal: the optical axis within 30 deg of the horizontal.
-      EXPECT_LT(std::abs(toDeg(std::asin(s.R_world_cam(2, 2)))), 30.0);
+      // Roughly horizontal: the optical axis within the tilt and the camera's pitch (8 deg) of
+      // the horizontal.
+      EXPECT_LE(std::abs(toDeg(std::asin(s.R_world_cam(2, 2)))),
+                config.robot_max_tilt_deg + sim::kRobotCameraPitchDeg + 1e-6);
       const double yaw = std::atan2(R_world_base(1, 0), R_world_base(0, 0));
       if (k > 0) {
         const double spacing = (base - previous_base).norm();
@@ -486,6 +492,16 @@ TEST(SceneSimulateBag, RoomRobotBagHasImagesAndNoCameraPose) {
   r = test::runTool(sim_exe + " --out " + test::tempPath("x.bag") + " --texture-poor");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--texture-poor"), std::string::npos) << r.err;
+  // The robot's tilt: only for the robot, and a range.
+  r = test::runTool(sim_exe + " --out " + test::tempPath("x.bag") +
+                    " --scenario room_handheld --robot-tilt-deg 10,30");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--robot-tilt-deg tilts the robot's base"), std::string::npos) << r.err;
+  r = test::runTool(sim_exe + " --out " + test::tempPath("x.bag") +
+                    " --scenario room_robot --robot-tilt-deg 30,10");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--robot-tilt-deg = 30,10: must be two numbers MIN,MAX"), std::string::npos)
+      << r.err;
 }
 
 }  // namespace

@@ -100,7 +100,10 @@ std::vector<StationaryPose> robotStops(const SimulationConfig& config, const Roo
           if (!scene.floorPointFree(q.x(), q.y(), kRadius)) return false;
         }
       }
-      const double tilt = deg2rad(5.0 + 15.0 * uni(*rng)), direction = 2.0 * kPi * uni(*rng);
+      const double tilt =
+                       deg2rad(config.robot_min_tilt_deg +
+                               (config.robot_max_tilt_deg - config.robot_min_tilt_deg) * uni(*rng)),
+                   direction = 2.0 * kPi * uni(*rng);
       const double pitch = tilt * std::cos(direction);
       const double roll =
           std::copysign(std::acos(std::cos(tilt) / std::cos(pitch)), std::sin(direction));

@@ -170,6 +170,20 @@ const std::vector<Key>& simulateBagOptionTable() {
           "--moving-objects", [](Options* o) { o->config.moving_objects = true; },
           "room scenarios: the two largest boxes slide 0.2-0.5 m back and forth, during the rests "
           "too (every frame is then rendered)"),
+      list(
+          "--robot-tilt-deg", 2,
+          [](const Options& o) {
+            return std::vector<double>{o.config.robot_min_tilt_deg, o.config.robot_max_tilt_deg};
+          },
+          [](const std::vector<double>& v, Options* o) {
+            if (!(v[0] >= 0.0 && v[0] <= v[1] && v[1] <= 40.0))
+              throw YAML::Exception({}, "out of range");
+            o->config.robot_min_tilt_deg = v[0];
+            o->config.robot_max_tilt_deg = v[1];
+          },
+          "two numbers MIN,MAX with 0 <= MIN <= MAX <= 40", "deg",
+          "--scenario room_robot: the base's tilt at each stop, uniform in [MIN, MAX] (default "
+          "5,20)"),
       flag(
           "--texture-poor", [](Options* o) { o->config.texture_poor = true; },
           "room scenarios: near-blank surfaces, faint texture (few features)"),
@@ -439,6 +453,13 @@ SimulateBagOptions parseSimulateBagOptions(const CliArgs& args) {
                               " changes the room scene: use it with --scenario room_robot or "
                               "room_handheld");
     }
+  }
+  if ((c.robot_min_tilt_deg != sim::SimulationConfig().robot_min_tilt_deg ||
+       c.robot_max_tilt_deg != sim::SimulationConfig().robot_max_tilt_deg) &&
+      c.motion != sim::MotionKind::kRoomRobot) {
+    throw SettingsError(source, "--robot-tilt-deg",
+                        "--robot-tilt-deg tilts the robot's base at its stops: use it with "
+                        "--scenario room_robot");
   }
   if (room && c.camera_pose) {
     throw SettingsError(source, "--camera-pose",

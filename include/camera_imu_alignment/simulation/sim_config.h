@@ -62,6 +62,9 @@ struct SimulationConfig {
   // Natural scene (room motions only; room_scene.h).
   bool moving_objects = false;  ///< the two largest boxes slide 0.2-0.5 m back and forth
   bool texture_poor = false;    ///< near-blank surfaces: faint texture, few features
+  /// room_robot: the base's tilt at each stop, acos(cos(pitch) cos(roll)), uniform in [min, max]
+  /// (deg; uneven ground), in a random direction.
+  double robot_min_tilt_deg = 5.0, robot_max_tilt_deg = 20.0;
 
   // Mounting. Random per seed (at least 30 deg from the identity) unless given.
   bool given_R_cam_imu = false;
