@@ -94,8 +94,8 @@ enum class SceneProfile {
   kFull,  ///< the defaults: SIFT on the full image, 1500 features, matches where detected
   /// SIFT on the image halved with 1000 features, each match refined at the full resolution
   /// (49 ms per view, 28 ms per pair on one core: the issue's cost targets). Not the default:
-  /// worse at a robot's stops with objects moved between them (BENCHMARKS.md, "Natural-scene
-  /// rotation").
+  /// with objects moving in view 1.4-1.7x the static scene's error, and not always within 3
+  /// sigma (BENCHMARKS.md, "Calibration without a board").
   kFast,
   kCustom,  ///< settings that are neither (sceneProfileOf only)
 };

@@ -57,8 +57,8 @@ Key sceneProfileKey() {
   return {"scene_profile",
           "",
           "without a target: full (SIFT on the full image) or fast (the image halved, each match "
-          "refined: about 50 ms per rest, 30 per pair; less accurate where a robot drove between "
-          "stops with objects moved)",
+          "refined: about 50 ms per rest, 30 per pair; for a scene that holds still: less accurate "
+          "with objects moving in view)",
           allowed,
           [](const YAML::Node& node, PipelineSettings* s) {
             SceneProfile profile = SceneProfile::kFull;
