@@ -168,12 +168,24 @@ Session solve(std::unique_ptr<sim::SimulationRun> run, const cia::PipelineSettin
       std::printf(" %s %.3f deg (sigma %.3f, chi2 %.1f)", what, cia::rad2deg(e.norm()),
                   cia::rad2deg(std::sqrt(cov.trace())), e.dot(cov.inverse() * e));
     };
+    std::printf("  links' excess noise %.3f deg per axis, %zu left out\n",
+                cia::rad2deg(std::sqrt(result.joint->camera_link_excess_variance_rad2)),
+                result.joint->camera_links_left_out.size());
     for (size_t j = 0; j < window.joint.camera_links.size(); ++j) {
       const cia::CameraLink& link = window.joint.camera_links[j];
       const auto& fit = result.joint->camera_orientation_fit;
       const Eigen::Matrix3d R_fit = fit[static_cast<size_t>(link.from_pose)].transpose() *
                                     fit[static_cast<size_t>(link.to_pose)];
-      std::printf("  link %zu (%d->%d):", j, link.from_pose, link.to_pose);
+      const auto& left_out = result.joint->camera_links_left_out;
+      const bool out =
+          std::find(left_out.begin(), left_out.end(), static_cast<int>(j)) != left_out.end();
+      const auto& refitted = result.joint->camera_links_refitted;
+      const bool refit =
+          std::find(refitted.begin(), refitted.end(), static_cast<int>(j)) != refitted.end();
+      std::printf(
+          "  link %zu (%d->%d)%s%s chi2 %.1f:", j, link.from_pose, link.to_pose,
+          out ? " LEFT OUT" : "", refit ? " refitted" : "",
+          j < result.joint->camera_link_chi2.size() ? result.joint->camera_link_chi2[j] : -1.0);
       describe("measured", link, link.R_from_to, link.cov_rad2);
       const std::optional<cia::SceneRotation> again =
           window.scene_link_refit(static_cast<int>(j), R_fit);
