@@ -143,7 +143,9 @@ TEST(FrameScreening, RenderedSharpAndBlurredFramesAreKeptAndAMisdetectedCornerDr
     kinds.push_back(kind);
     ++counts[kind];
     const double error_deg = test::angleBetweenDeg(pose->R_target_cam, o.R_target_cam_true);
-    if (kind == kBlurred) EXPECT_LT(error_deg, 0.1) << "frame " << j << ": the fit is sound";
+    if (kind == kBlurred) {
+      EXPECT_LT(error_deg, 0.1) << "frame " << j << ": the fit is sound";
+    }
     std::printf("frame %3zu at %3.0f deg/s %-12s reprojection RMS %.3f px, PnP %.3f deg off\n", j,
                 speed_deg_s,
                 kind == kSharp     ? "sharp"
@@ -186,7 +188,9 @@ TEST(MotionFrameScreening, TheWindowsFramesAreJudgedByEachOtherAndTheDroppedEras
   ASSERT_EQ(frames.size(), 58u);
   for (std::size_t k = 0; k < frames.size(); ++k) {
     EXPECT_EQ(std::count(poor_stamps.begin(), poor_stamps.end(), frames[k].stamp_s), 0);
-    if (k > 0) EXPECT_GT(frames[k].stamp_s, frames[k - 1].stamp_s) << "stamp order kept";
+    if (k > 0) {
+      EXPECT_GT(frames[k].stamp_s, frames[k - 1].stamp_s) << "stamp order kept";
+    }
   }
   EXPECT_GT(screening.typical_rms_px, 1.0) << "above the 1 px setting, and kept";
 }

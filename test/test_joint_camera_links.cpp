@@ -446,7 +446,9 @@ TEST(JointCameraLinks, LinksAreFittedAgainWithTheRotationHeldNearTheEstimate) {
     for (std::size_t j = 0; j < truth.size(); ++j) {
       const bool taken = std::find(refitted.begin(), refitted.end(), j) != refitted.end();
       // A clean link's refit is its own rotation: nothing to take.
-      if (!compromised[j]) EXPECT_FALSE(taken) << "seed " << seed << " link " << j;
+      if (!compromised[j]) {
+        EXPECT_FALSE(taken) << "seed " << seed << " link " << j;
+      }
     }
     const auto compromised_count = std::count(compromised.begin(), compromised.end(), true);
     EXPECT_GE(static_cast<int>(refitted.size()), compromised_count - 1) << "seed " << seed;
