@@ -107,19 +107,26 @@ Share measureShare(const sim::SimulationRun& run, const cia::SceneFeatureSetting
   return share;
 }
 
-/// The features' profile (argument 5): "default" (SIFT on the full image, 1500 features, the
-/// matches where they were detected), "fast" (SIFT on the image halved, 1000 features, each match
-/// refined at the full resolution), or the two halves of the difference: "halved" (fast, not
-/// refined) and "fullrefined" (default, refined). Empty settings: not a profile.
+/// The features' profile (argument 5): "default" or "full" (SIFT on the full image, 1500
+/// features, the matches where they were detected), "fast" (SIFT on the image halved, 1000
+/// features, each match refined at the full resolution), or the two halves of the difference:
+/// "halved" (fast, not refined) and "fullrefined" (default, refined). Empty settings: not a
+/// profile.
 std::optional<cia::PipelineSettings> profileSettings(const std::string& profile) {
   cia::PipelineSettings settings;
-  if (profile == "default" || profile == "full") return settings;
-  const bool halved = profile == "fast" || profile == "halved";
-  if (!halved && profile != "fullrefined") return std::nullopt;
-  if (halved)
+  cia::SceneProfile named = cia::SceneProfile::kFull;
+  if (profile == "default") return settings;
+  if (cia::parseSceneProfile(profile, &named)) {  // full, fast: the setting scene_profile's
+    cia::useSceneProfile(named, &settings.scene_features, &settings.scene_rotation);
+  } else if (profile == "halved") {
     cia::useSceneProfile(cia::SceneProfile::kFast, &settings.scene_features,
                          &settings.scene_rotation);
-  settings.scene_rotation.refine_matches = profile != "halved";
+    settings.scene_rotation.refine_matches = false;
+  } else if (profile == "fullrefined") {
+    settings.scene_rotation.refine_matches = true;
+  } else {
+    return std::nullopt;
+  }
   return settings;
 }
 
@@ -241,7 +248,7 @@ int main(int argc, char** argv) {
   const std::optional<cia::PipelineSettings> chosen = profileSettings(profile);
   if (!chosen) {
     std::fprintf(stderr,
-                 "bench_scene_moving: profile %s is not one of default, fast, halved, "
+                 "bench_scene_moving: profile %s is not one of default, full, fast, halved, "
                  "fullrefined\n",
                  profile.c_str());
     return 2;

@@ -75,14 +75,15 @@ inline int sceneSeedCount(int default_count) {
   return n > 0 ? n : default_count;
 }
 
-/// CIA_SCENE_PROFILE=fast: the features' fast profile (SIFT on the image halved, 1000 features,
-/// each match refined at the full resolution; BENCHMARKS.md, "Natural-scene rotation"); unset:
-/// the defaults.
+/// CIA_SCENE_PROFILE=fast (or full; the setting scene_profile's words): the features' fast profile
+/// (SIFT on the image halved, 1000 features, each match refined at the full resolution;
+/// BENCHMARKS.md, "Natural-scene rotation"); unset: the defaults.
 inline PipelineSettings sceneProfileSettings() {
   PipelineSettings settings;
-  const char* profile = std::getenv("CIA_SCENE_PROFILE");
-  if (profile && std::string(profile) == "fast") {
-    useSceneProfile(SceneProfile::kFast, &settings.scene_features, &settings.scene_rotation);
+  const char* word = std::getenv("CIA_SCENE_PROFILE");
+  SceneProfile profile = SceneProfile::kFull;
+  if (word && parseSceneProfile(word, &profile)) {
+    useSceneProfile(profile, &settings.scene_features, &settings.scene_rotation);
   }
   return settings;
 }
