@@ -79,11 +79,23 @@ TEST(BroadcastGate, JointEstimateJudgedByChiSquareNotByThePairResidual) {
   // A large pair residual (a consumer gyro chain) does not matter for a consistent joint estimate.
   EXPECT_EQ(judgeEstimate(jointResult(0.05, turned(0), 0.3), 10, s, std::nullopt, false).decision,
             GateDecision::kBroadcast);
-  // An inconsistent one is refused, naming the test and the parameter.
-  const GateOutcome inconsistent =
-      judgeEstimate(jointResult(0.05, turned(0), 1e-5), 10, s, std::nullopt, false);
+  // An inconsistent one (the test fails and the residuals are 1.41x their noise) is refused,
+  // naming the effect size, the test and the parameter.
+  AlignmentResult misfit = jointResult(0.05, turned(0), 1e-5);
+  misfit.joint->chi2 = 100;
+  const GateOutcome inconsistent = judgeEstimate(misfit, 10, s, std::nullopt, false);
   EXPECT_EQ(inconsistent.decision, GateDecision::kReject);
   EXPECT_NE(inconsistent.why.find("consistency_level"), std::string::npos) << inconsistent.why;
+  EXPECT_NE(inconsistent.why.find("1.41x their measured noise (fair"), std::string::npos)
+      << inconsistent.why;
+  // With thousands of degrees of freedom the test rejects a misfit that moves nothing (5 %
+  // over the noise): the p-value alone does not fail the estimate.
+  AlignmentResult large = jointResult(0.05, turned(0), 1e-9);
+  large.joint->dof = 5000;
+  large.joint->chi2 = 5000 * 1.1;
+  EXPECT_EQ(judgeEstimate(large, 10, s, std::nullopt, false).decision, GateDecision::kBroadcast);
+  large.joint->chi2 = 5000 * 1.5;  // 1.22x: beyond the band
+  EXPECT_EQ(judgeEstimate(large, 10, s, std::nullopt, false).decision, GateDecision::kReject);
   AlignmentResult failed = jointResult(0.05, turned(0), 0.3);
   failed.joint->ok = false;
   failed.joint->message = "the solver failed";

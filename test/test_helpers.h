@@ -15,12 +15,18 @@
 #include <random>
 #include <string>
 
+#include "camera_imu_alignment/results/joint_result.h"
 #include "camera_imu_alignment/solver/rotation_pair.h"
 
 namespace camera_imu_alignment {
 namespace test {
 
 constexpr double kPiTest = 3.14159265358979323846;
+
+/// The variance factor a joint estimate learned for the motion frames' camera orientation.
+inline double cameraNoiseFactor(const JointResult& joint) {
+  return joint.noise.variance_factor[static_cast<size_t>(NoiseKind::kCameraMotion)];
+}
 inline double toDeg(double rad) { return rad * 180.0 / kPiTest; }
 
 /// Uniform random rotation (normalised Gaussian quaternion).

@@ -204,10 +204,17 @@ TEST(ReportFigures, JointResidualsPerPoseComeFromTheJointEstimateOfTheWindow) {
   for (int k = 0; k < 6; ++k) {
     EXPECT_EQ(figures.poses[k].joint_residual_sigma, joint.pose_residual_norm[k]);
   }
-  EXPECT_EQ(jointConsistencyText(joint), "chi2/dof 1.02 (150 dof, p 0.420: consistent)");
+  EXPECT_EQ(jointConsistencyText(joint),
+            "chi2/dof 1.02 (150 dof, p 0.420; residuals 1.01x their noise, good: consistent)");
   joint.chi2_p_value = 0.001;
   joint.consistency_level = 0.01;  // the level the gate judged it at (consistency_level)
-  EXPECT_EQ(jointConsistencyText(joint), "chi2/dof 1.02 (150 dof, p 0.001: INCONSISTENT)");
+  // Failed by the test but within kConsistentMisfitRatio of the noise: the effect size decides.
+  EXPECT_EQ(jointConsistencyText(joint),
+            "chi2/dof 1.02 (150 dof, p 0.001; residuals 1.01x their noise, good: consistent)");
+  joint.chi2 = 300.0;
+  joint.chi2_p_value = 1e-12;
+  EXPECT_EQ(jointConsistencyText(joint),
+            "chi2/dof 2.00 (150 dof, p 0.000; residuals 1.41x their noise, fair: INCONSISTENT)");
   // A joint estimate over another number of poses than the window is not matched to poses.
   in.result.joint->pose_residual_norm.pop_back();
   in.window_poses = 6;

@@ -110,8 +110,9 @@ const char* kNoCameraData =
 
 /// --imu-yaml: the Kalibr imu.yaml of the joint estimate. White noise densities from the rests:
 /// the median over the rests of the per-sample scatter times sqrt(sample period).
+/// `imu_rate_hz` (the recording's mean rate) stands in for the rests' when there are none.
 bool writeImuYaml(const std::string& path, const cia::ReportInput& report,
-                  const std::string& imu_topic) {
+                  const std::string& imu_topic, double imu_rate_hz) {
   if (!report.result.joint || !report.result.joint->ok) {
     std::cerr << "calibrate_bag: --imu-yaml " << path
               << ": no joint estimate (--imu-orientation joint) to write\n";
@@ -131,8 +132,8 @@ bool writeImuYaml(const std::string& path, const cia::ReportInput& report,
     return v[v.size() / 2];
   };
   std::ofstream out(path);
-  out << cia::kalibrImuYaml(*report.result.joint, median(gyro), median(accel), median(rate),
-                            imu_topic);
+  out << cia::kalibrImuYaml(*report.result.joint, median(gyro), median(accel),
+                            rate.empty() ? imu_rate_hz : median(rate), imu_topic);
   if (!out) {
     std::cerr << "calibrate_bag: --imu-yaml " << path << ": cannot write the file\n";
     return false;
@@ -383,7 +384,11 @@ int run(const cia::CliArgs& args) {
       return kExitBadInput;
     }
   }
-  if (args.has("--imu-yaml") && !writeImuYaml(args.get("--imu-yaml"), report, topics.imu)) {
+  if (args.has("--imu-yaml") &&
+      !writeImuYaml(args.get("--imu-yaml"), report, topics.imu,
+                    info.end_s > info.start_s
+                        ? static_cast<double>(snap.inputs.imu_samples) / (info.end_s - info.start_s)
+                        : 0.0)) {
     return kExitBadInput;
   }
   return kExitOk;

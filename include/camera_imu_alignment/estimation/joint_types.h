@@ -173,6 +173,10 @@ struct JointProblem {
   /// Set by the estimator from motion_frames with positions and motion_gyro's accelerometer
   /// (callers leave it empty).
   std::vector<AccelLink> accel_links;
+  /// The noise of each learned kind (NoiseKind) relative to the stated one that the problem is
+  /// solved under: the estimator's start, and what it learned (JointResult::noise) when a caller
+  /// solves a variant of the same recording (the mount-change fits). Callers leave it at 1.
+  NoiseFactors noise = unitNoiseFactors();
 };
 
 /// 1-sigma of the Gaussian priors on the IMU parameters (mean: the ideal sensor, T = I, bias 0).
@@ -245,6 +249,12 @@ struct JointSettings {
   /// a solve, and with one pose after a split and no magnetometer the second mount's rotation
   /// about that pose's gravity is determined by nothing but a weak prior).
   bool compute_covariance = true;
+  /// Learn the noise of each measurement kind (NoiseKind) from the recording: its variance
+  /// factor estimated from its residuals' chi-square and redundancy and the window solved again
+  /// until the factors settle (variance-component estimation, JointResult::noise). A kind with
+  /// less redundancy than kMinNoiseRedundancy keeps the stated noise. Only with
+  /// compute_covariance (fits compared with each other keep the problem's JointProblem::noise).
+  bool learn_noise = true;
 
   // What the data determine. Every parameter is estimated with its prior: no geometric rule (of
   // rotation angles, gravity or field directions) decides what is estimated. A parameter the poses

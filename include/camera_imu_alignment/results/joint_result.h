@@ -6,7 +6,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,6 +18,15 @@ namespace camera_imu_alignment {
 /// Default significance level of the chi-square consistency test (the consistency_level setting,
 /// online/online_types.h).
 inline constexpr double kDefaultConsistencyLevel = 1e-3;
+/// Residuals within this factor of their noise (JointResult::misfitRatio) are consistent whatever
+/// the chi-square test's p-value: "good" up to it, "fair" up to kFairMisfitRatio, "poor" beyond.
+inline constexpr double kConsistentMisfitRatio = 1.2;
+inline constexpr double kFairMisfitRatio = 1.5;
+/// "good", "fair" or "poor" (the bands above).
+inline const char* misfitBand(double misfit_ratio) {
+  if (misfit_ratio <= kConsistentMisfitRatio) return "good";
+  return misfit_ratio <= kFairMisfitRatio ? "fair" : "poor";
+}
 
 enum class ImuMatrixModel {
   kEstimate,  ///< estimated, held by their priors (ImuModelPriors)
@@ -24,6 +35,72 @@ enum class ImuMatrixModel {
   /// minus the estimated one's, chi-square with as many degrees of freedom as free entries of T,
   /// p below model_selection_level): the data's own evidence for scale and misalignment errors.
   kSelect
+};
+
+/// The measurement kinds whose noise the joint estimator learns from the recording (variance
+/// components, JointSettings::learn_noise): the camera's orientation at the motion nodes, the
+/// camera's position at the acceleration model's keyframes, the gyro's white noise (the relative
+/// rotations it integrates), the accelerometer's white noise during motion (the acceleration
+/// model's links) and both biases' random walks.
+enum class NoiseKind {
+  kCameraMotion,
+  kCameraPosition,
+  kGyroWhite,
+  kAccelWhite,
+  kGyroWalk,
+  kAccelWalk
+};
+inline constexpr int kNoiseKinds = 6;
+/// "camera_orientation", "camera_position", "gyro_noise", "accel_noise", "gyro_walk",
+/// "accel_walk".
+inline const char* toString(NoiseKind kind) {
+  switch (kind) {
+    case NoiseKind::kCameraMotion:
+      return "camera_orientation";
+    case NoiseKind::kCameraPosition:
+      return "camera_position";
+    case NoiseKind::kGyroWhite:
+      return "gyro_noise";
+    case NoiseKind::kAccelWhite:
+      return "accel_noise";
+    case NoiseKind::kGyroWalk:
+      return "gyro_walk";
+    case NoiseKind::kAccelWalk:
+      break;
+  }
+  return "accel_walk";
+}
+
+/// Variance factors of the measurement kinds: the noise variance the recording shows over the
+/// stated one (the datasheet, the driver's covariance or the settings'); 1 = as stated.
+using NoiseFactors = std::array<double, kNoiseKinds>;
+inline NoiseFactors unitNoiseFactors() { return {1.0, 1.0, 1.0, 1.0, 1.0, 1.0}; }
+
+/// The noise as the recording shows it: per kind, the variance factor the estimate used, the
+/// robust chi-square of that kind's residuals under it and their redundancy (residuals minus the
+/// share of the parameters they determine, the trace of their hat matrix), whence the factor
+/// (variance-component estimation: factor x chi2 / redundancy, iterated with the solve).
+struct LearnedNoise {
+  NoiseFactors variance_factor = unitNoiseFactors();
+  std::array<double, kNoiseKinds> chi2{}, redundancy{};
+  std::array<int, kNoiseKinds> residuals{};
+  /// The kind had redundancy enough to learn its factor (else it kept the stated noise).
+  std::array<bool, kNoiseKinds> learned{};
+  /// The stated 1-sigma noise of each kind (0: the recording has none of it), in the kind's
+  /// units: camera orientation rad (the median motion frame's, per axis), camera position m,
+  /// gyro white noise rad/s/sqrt(Hz), accelerometer white noise m/s^2/sqrt(Hz), gyro bias walk
+  /// rad/s/sqrt(s), accelerometer bias walk m/s^2/sqrt(s) (Kalibr's imu.yaml units).
+  std::array<double, kNoiseKinds> stated{};
+  /// The kind's noise as measured: stated x sigmaFactor (the stated value where not learned).
+  double measured(NoiseKind kind) const {
+    return stated[static_cast<size_t>(kind)] * sigmaFactor(kind);
+  }
+  bool settled = true;  ///< the factors changed by less than 10 % in the last pass
+  int passes = 0;       ///< passes that updated a factor
+  /// The 1-sigma noise factor of a kind: sqrt(variance_factor).
+  double sigmaFactor(NoiseKind kind) const {
+    return std::sqrt(variance_factor[static_cast<size_t>(kind)]);
+  }
 };
 
 /// One reported parameter block.
@@ -98,10 +175,9 @@ struct JointResult {
   Eigen::Matrix3d covariance_rad2 = Eigen::Matrix3d::Zero();
   Eigen::Vector3d std_dev_deg = Eigen::Vector3d::Zero();  ///< camera x, y, z axes
   double covariance_scale = 1.0;  ///< chi2 / dof applied to every covariance (1 when <= 1)
-  /// Factor the motion frames' camera covariance (MotionFrame::cov_cam_rad2) was scaled by before
-  /// the final solve, when the residuals said it was understated (chi2/dof > 2; then until < 1.1):
-  /// 1 when not. Understated, the motion would outweigh the IMU's priors (JointEstimator::solve).
-  double motion_covariance_scale = 1.0;
+  /// The noise of each measurement kind as the recording shows it (JointSettings::learn_noise);
+  /// every covariance and chi-square of this result is under it.
+  LearnedNoise noise;
   /// With JointProblem::mount_change_pose: R_cam_imu of the poses from that index on (R_cam_imu
   /// is then the earlier poses').
   std::optional<Eigen::Matrix3d> R_cam_imu_after_change;
@@ -118,8 +194,15 @@ struct JointResult {
   /// consistency_level setting here when its gate judges the estimate, so that the result YAML, the
   /// report and the status print the gate's verdict (consistent()), never one of their own.
   double consistency_level = kDefaultConsistencyLevel;
-  /// The chi-square test passed: ok and chi2_p_value >= consistency_level.
-  bool consistent() const { return ok && chi2_p_value >= consistency_level; }
+  /// The residuals' size against their noise (learned where the recording allows): sqrt(chi2 /
+  /// dof), about 1 when the model holds. The effect size the consistency verdict reads.
+  double misfitRatio() const { return dof > 0 ? std::sqrt(std::max(0.0, chi2) / dof) : 0.0; }
+  /// The consistency verdict: ok, and the chi-square test passes (chi2_p_value >=
+  /// consistency_level) or the misfit is within kConsistentMisfitRatio (with thousands of degrees
+  /// of freedom the test rejects a misfit that moves nothing: the effect size decides then).
+  bool consistent() const {
+    return ok && (chi2_p_value >= consistency_level || misfitRatio() <= kConsistentMisfitRatio);
+  }
   /// Per pose: RMS whitened residual (sigma units) over its camera, accelerometer, magnetometer and
   /// gyro-bias residuals and half of each adjacent gyro residual.
   std::vector<double> pose_residual_norm;

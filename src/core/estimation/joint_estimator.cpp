@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -18,14 +19,18 @@
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "joint_motion.h"
 #include "joint_state.h"
+#include "noise_components.h"
 
 namespace camera_imu_alignment {
 namespace {
 
 /// The gyro linearisation is redone until the gyro model moves less than this between passes
 /// (T_g entries, rad/s for the biases): the first-order preintegration error, ~change^2 x the
-/// rotation angle, is then ~1e-10 rad.
-constexpr double kRelinearisationThreshold = 1e-5;
+/// rotation angle, is then ~1e-8 rad per radian turned.
+constexpr double kRelinearisationThreshold = 1e-4;
+/// Passes beyond max_relinearisations that learning the noise may take (JointSettings::
+/// learn_noise).
+constexpr int kMaxNoisePasses = 6;
 
 GyroExcitation excitationOf(const std::vector<GyroPreintegration>& segments) {
   GyroExcitation excitation;
@@ -61,9 +66,10 @@ ceres::Solver::Options solverOptions(const JointSettings& settings) {
   // (the acceleration model's keyframe states; bench_motion's window solve 745 -> 466 ms).
   options.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
   options.max_num_iterations = settings.max_iterations;
-  // Converged when the cost changes by less than 1e-10 of itself: at chi2 ~ dof that leaves
-  // R_cam_imu within ~1e-8 rad of the minimum (tighter only chases rounding).
-  options.function_tolerance = 1e-10;
+  // Converged when the cost changes by less than 1e-6 of itself: at chi2 ~ dof ~ 2000 a step of
+  // 1e-3 in the cost, a few hundredths of a sigma from the minimum in the slowest direction (the
+  // passes that follow go on from there). Tighter chases the robust loss's slow tail.
+  options.function_tolerance = 1e-6;
   options.gradient_tolerance = 1e-12;
   options.parameter_tolerance = 1e-10;
   options.num_threads = std::max(1, settings.solver_threads);
@@ -109,9 +115,14 @@ JointObservability heldByInformation(JointObservability observability, const Joi
 /// One solve with the matrices' model of `settings` (kEstimate or kIdentity). With
 /// pin_unexcited_parameters: a first solve with every parameter free finds what the data do not
 /// determine (`held` null), a second one holds it (`held`: what to estimate).
-JointResult solveModel(const JointProblem& problem, const Eigen::Matrix3d& R_cam_imu_initial,
+JointResult solveModel(const JointProblem& given, const Eigen::Matrix3d& R_cam_imu_initial,
                        const JointSettings& settings, const JointObservability* held = nullptr) {
   const auto start = std::chrono::steady_clock::now();
+  // Learning the noise changes the problem's factors between passes: a copy then.
+  const bool learn = settings.learn_noise && settings.compute_covariance;
+  std::optional<JointProblem> learning;
+  if (learn) learning = given;
+  const JointProblem& problem = learn ? *learning : given;
   JointResult result;
   const auto finish = [&](JointResult& r) -> JointResult {
     r.solve_time_s =
@@ -161,8 +172,16 @@ JointResult solveModel(const JointProblem& problem, const Eigen::Matrix3d& R_cam
   }
 
   const ceres::Solver::Options options = solverOptions(settings);
-  bool converged = false, gyro_settled = true;
-  for (int pass = 0; pass < settings.max_relinearisations; ++pass) {
+  bool converged = false, gyro_settled = true, noise_settled = true;
+  // While the noise is learned, no robust loss: scaled by the stated noise, most residuals lie
+  // in Huber's linear tail, where Gauss-Newton converges slowly (tens of iterations a pass).
+  std::optional<joint::NoiseLearner> learner;
+  if (learn) learner.emplace(problem.noise);
+  bool robust_pass = !learn;
+  JointSettings unrobust_settings = settings;
+  unrobust_settings.robust_loss = RobustLossKind::kNone;
+  const int max_passes = settings.max_relinearisations + (learn ? kMaxNoisePasses : 0);
+  for (int pass = 0; pass < max_passes; ++pass) {
     if (pass > 0) {
       const Eigen::Matrix3d T_g = state.gyroMatrix();
       if (!T_g.allFinite() || !(std::abs(T_g.determinant()) > 0.5)) {
@@ -178,9 +197,9 @@ JointResult solveModel(const JointProblem& problem, const Eigen::Matrix3d& R_cam
     // biases holds the state's (set above, or before the first pass).
     const std::vector<joint::AccelLinkIntegral> accel_links =
         joint::integrateAccelLinks(problem, state.gyroMatrix(), biases, state.timeshift[0]);
-    const joint::BuiltProblem built =
-        joint::buildProblem(problem, gyro, rates_from, rates_to, accel_links, whitening,
-                            observability, settings, &state, &ceres_problem);
+    const joint::BuiltProblem built = joint::buildProblem(
+        problem, gyro, rates_from, rates_to, accel_links, whitening, observability,
+        robust_pass ? settings : unrobust_settings, &state, &ceres_problem);
     ceres::Solver::Summary solver_summary;
     ceres::Solve(options, &ceres_problem, &solver_summary);
     result.iterations += static_cast<int>(solver_summary.iterations.size());
@@ -193,7 +212,25 @@ JointResult solveModel(const JointProblem& problem, const Eigen::Matrix3d& R_cam
     // With gyro segments at least two passes: the first is linearised about the ideal gyro.
     const bool judged = problem.segments.empty() || pass >= 1;
     gyro_settled = gyroModelChange(problem, state, gyro) < kRelinearisationThreshold;
-    const bool last = pass + 1 == settings.max_relinearisations || (judged && gyro_settled);
+    if (learner && !robust_pass) {
+      const bool moved = learner->update(problem, whitening, built, &state, &ceres_problem);
+      noise_settled = !moved;
+      if (pass + 1 < max_passes && (moved || settings.robust_loss != RobustLossKind::kNone)) {
+        // Solved again: under the new factors, or (settled) once more with the robust loss.
+        if (moved) {
+          learner->advance();
+          learning->noise = learner->factors();
+          if (!joint::computeWhitening(problem, gyro, settings, &whitening, &result.message)) {
+            return finish(result);
+          }
+        } else {
+          robust_pass = true;
+        }
+        state.foldRotationIncrements();
+        continue;
+      }
+    }
+    const bool last = pass + 1 == max_passes || (judged && gyro_settled);
     if (last) {
       if (!joint::fillResult(problem, state, built, whitening, observability, settings,
                              &ceres_problem, &result)) {
@@ -213,6 +250,16 @@ JointResult solveModel(const JointProblem& problem, const Eigen::Matrix3d& R_cam
     return finish(result);
   }
   result.notes = observability.notes;
+  if (learner) {
+    result.noise = learner->noise();
+    result.noise.settled = noise_settled;
+  } else {
+    result.noise.variance_factor = problem.noise;
+  }
+  if (!noise_settled) {
+    result.notes.push_back("the measured noise still changed in the last of " +
+                           std::to_string(max_passes) + " passes");
+  }
   result.imu_matrices = settings.imu_matrices;
   describeInformation(observability, settings, &result);
   if (!(result.std_dev_deg.maxCoeff() <= settings.undetermined_std_dev_deg)) {
@@ -308,7 +355,18 @@ JointResult selectModel(const JointProblem& problem, const Eigen::Matrix3d& R_ca
       return estimated;
     }
   }
-  JointResult identity = solveModel(problem, R_cam_imu_initial, identity_settings);
+  // Compared under one noise model: the identity model is fitted under the noise the estimated
+  // one learned (learning its own, its misfit would pass for noise).
+  JointResult identity;
+  if (estimated.ok && settings.learn_noise && settings.compute_covariance) {
+    JointProblem same_noise = problem;
+    same_noise.noise = estimated.noise.variance_factor;
+    identity_settings.learn_noise = false;
+    identity = solveModel(same_noise, R_cam_imu_initial, identity_settings);
+    identity.noise = estimated.noise;
+  } else {
+    identity = solveModel(problem, R_cam_imu_initial, identity_settings);
+  }
   if (!identity.ok) return estimated;
   if (!estimated.ok) {
     identity.notes.push_back("T_g and T_a held at identity: estimating them failed (" +
@@ -501,6 +559,54 @@ JointResult withCameraNoiseAsMeasured(JointProblem* problem, JointResult chosen,
   return chosen;
 }
 
+/// The stated noise of each learned kind (LearnedNoise::stated) and a note on what the recording
+/// showed of it.
+void describeLearnedNoise(const JointProblem& problem, const JointSettings& settings,
+                          JointResult* result) {
+  LearnedNoise& noise = result->noise;
+  std::vector<double> camera_sigma;
+  for (const JointPose& pose : problem.poses) {
+    if (!pose.at_rest) camera_sigma.push_back(std::sqrt(pose.cov_cam_rad2.trace() / 3.0));
+  }
+  if (!camera_sigma.empty()) {
+    std::nth_element(camera_sigma.begin(), camera_sigma.begin() + camera_sigma.size() / 2,
+                     camera_sigma.end());
+    noise.stated[static_cast<size_t>(NoiseKind::kCameraMotion)] =
+        camera_sigma[camera_sigma.size() / 2];
+  }
+  const auto statedOf = [&](NoiseKind kind) -> double& {
+    return noise.stated[static_cast<size_t>(kind)];
+  };
+  if (!problem.accel_links.empty())
+    statedOf(NoiseKind::kCameraPosition) = settings.camera_position_sigma_m;
+  double gyro_density = problem.motion_gyro.noise_density_rad_s_sqrt_hz;
+  for (const GyroSegment& segment : problem.segments) {
+    if (!(gyro_density > 0.0)) gyro_density = segment.noise_density_rad_s_sqrt_hz;
+  }
+  statedOf(NoiseKind::kGyroWhite) = gyro_density;
+  if (!problem.accel_links.empty()) {
+    statedOf(NoiseKind::kAccelWhite) =
+        problem.accel_links.front().samples.accel_noise_density_m_s2_sqrt_hz;
+  }
+  statedOf(NoiseKind::kGyroWalk) = settings.priors.gyro_bias_walk_rad_s_sqrt_s;
+  statedOf(NoiseKind::kAccelWalk) = settings.priors.accel_bias_walk_m_s2_sqrt_s;
+  std::string learned;
+  for (int k = 0; k < kNoiseKinds; ++k) {
+    const auto kind = static_cast<NoiseKind>(k);
+    if (!noise.learned[static_cast<size_t>(k)] || !(noise.stated[static_cast<size_t>(k)] > 0.0)) {
+      continue;
+    }
+    char buffer[96];
+    std::snprintf(buffer, sizeof(buffer), "%s%s %.3g (%.2fx stated)", learned.empty() ? "" : ", ",
+                  toString(kind), noise.measured(kind), noise.sigmaFactor(kind));
+    learned += buffer;
+  }
+  if (!learned.empty()) {
+    result->notes.push_back("the noise as the recording shows it (variance components): " +
+                            learned);
+  }
+}
+
 }  // namespace
 
 JointEstimator::JointEstimator(JointSettings settings) : settings_(std::move(settings)) {}
@@ -515,39 +621,12 @@ JointResult JointEstimator::solve(const JointProblem& problem,
     return refused;
   }
   joint::ExpandedProblem expanded = joint::expandMotion(problem, settings_);
-  JointResult chosen = withCameraNoiseAsMeasured(
-      &expanded.problem, screenMagnetometer(expanded.problem, R_cam_imu_initial, settings_),
-      R_cam_imu_initial, settings_);
-  // A motion frame's covariance is often a guess (camera_pose states none; blur and jitter grow
-  // with the speed). Understated, the motion outweighs the IMU's priors and T_g's rotation, which
-  // trades off with R_cam_imu without rests, absorbs the misfit (BENCHMARKS.md, BROAD): scaled.
-  // Not for the fits alone (compute_covariance false), which compare chi-square values; the
-  // mount-change test runs on the rests alone (mount_change.h).
-  double motion_scale = 1.0;
-  for (int round = 0; round < joint::kMaxMotionReweights && chosen.ok &&
-                      expanded.motion_nodes > 0 && settings_.compute_covariance;
-       ++round) {
-    const double misfit = chosen.dof > 0 ? chosen.chi2 / chosen.dof : 0.0;
-    if (!(misfit > (round == 0 ? joint::kMotionReweightAbove : joint::kMotionReweightSettled))) {
-      break;
-    }
-    for (JointPose& pose : expanded.problem.poses) {
-      if (!pose.at_rest) pose.cov_cam_rad2 *= misfit;
-    }
-    JointResult again = screenMagnetometer(expanded.problem, R_cam_imu_initial, settings_);
-    if (!again.ok) break;  // the last usable estimate stands
-    motion_scale *= misfit;
-    chosen = std::move(again);
-  }
-  if (chosen.ok && motion_scale > 1.0) {
-    char buffer[160];
-    std::snprintf(buffer, sizeof(buffer),
-                  "the motion frames' camera covariance scaled by %.1f (1-sigma x %.2f): their "
-                  "residuals exceeded it",
-                  motion_scale, std::sqrt(motion_scale));
-    chosen.notes.push_back(buffer);
-    chosen.motion_covariance_scale = motion_scale;
-  }
+  JointResult first = screenMagnetometer(expanded.problem, R_cam_imu_initial, settings_);
+  // Solved again (the camera's excess noise below), the window starts from the noise learned.
+  if (first.ok) expanded.problem.noise = first.noise.variance_factor;
+  JointResult chosen =
+      withCameraNoiseAsMeasured(&expanded.problem, std::move(first), R_cam_imu_initial, settings_);
+  if (chosen.ok) describeLearnedNoise(expanded.problem, settings_, &chosen);
   joint::mapResultToCaller(expanded, &chosen);
   chosen.solve_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -229,6 +229,7 @@ ExpandedProblem expandMotion(const JointProblem& problem, const JointSettings& s
   expanded.mount_change_pose = -1;
   expanded.timeshift_initial_s = problem.timeshift_initial_s;
   expanded.timeshift_prior_sigma_s = problem.timeshift_prior_sigma_s;
+  expanded.noise = problem.noise;
   std::vector<int> frame_of_pose;  // per expanded pose: its motion frame, -1 for a rest
   for (const auto& [time, index] : order) {
     frame_of_pose.push_back(index >= 0 ? -1 : static_cast<int>(node_frame[-1 - index]));

@@ -115,6 +115,12 @@ class Builder {
               bool magnetometer = false) {
     built_.residuals.push_back({id, pose, other_pose, size, magnetometer});
   }
+  /// The last recorded residual measures `kind` (its noise is learned, JointProblem::noise).
+  void learned(NoiseKind kind) { built_.residuals.back().noise_kind = static_cast<int>(kind); }
+  /// 1-sigma factor of a learned kind in this problem.
+  double sigmaFactor(NoiseKind kind) const {
+    return std::sqrt(problem_.noise[static_cast<size_t>(kind)]);
+  }
 
   bool afterChange(size_t k) const {
     return problem_.mount_change_pose >= 0 && static_cast<int>(k) >= problem_.mount_change_pose;
@@ -140,6 +146,7 @@ class Builder {
         auto* camera = new ceres::NormalPrior(whitening_.camera[k], ceres::Vector::Zero(3));
         record(ceres_.AddResidualBlock(camera, loss_, state_.delta[k].data()), static_cast<int>(k),
                -1, 3);
+        learned(NoiseKind::kCameraMotion);
         continue;
       }
       const JointPose& pose = problem_.poses[k];
@@ -183,10 +190,12 @@ class Builder {
         const size_t k = rests_[i], l = rests_[i + 1];
         const double dt = std::max(std::abs(restCentre(l) - restCentre(k)), kMinWalkDt);
         auto* walk = new ceres::AutoDiffCostFunction<BiasWalkResidual, 3, 3, 3>(
-            new BiasWalkResidual{1.0 / (p.accel_bias_walk_m_s2_sqrt_s * std::sqrt(dt))});
+            new BiasWalkResidual{1.0 / (p.accel_bias_walk_m_s2_sqrt_s *
+                                        sigmaFactor(NoiseKind::kAccelWalk) * std::sqrt(dt))});
         record(ceres_.AddResidualBlock(walk, nullptr, state_.accel_bias[k].data(),
                                        state_.accel_bias[l].data()),
                static_cast<int>(k), static_cast<int>(l), 3);
+        learned(NoiseKind::kAccelWalk);
       }
     } else {
       for (size_t k : rests_) holdBlock(state_.accel_bias[k].data());
@@ -287,7 +296,8 @@ class Builder {
              static_cast<int>(k), -1, 3);
     }
     // Bias random walk between consecutive rests of one group.
-    const double walk = settings_.priors.gyro_bias_walk_rad_s_sqrt_s;
+    const double walk =
+        settings_.priors.gyro_bias_walk_rad_s_sqrt_s * sigmaFactor(NoiseKind::kGyroWalk);
     for (size_t k = 0; k + 1 < n; ++k) {
       const JointPose& a = problem_.poses[k];
       const JointPose& b = problem_.poses[k + 1];
@@ -298,6 +308,7 @@ class Builder {
       record(ceres_.AddResidualBlock(cost, nullptr, state_.gyro_bias[k].data(),
                                      state_.gyro_bias[k + 1].data()),
              static_cast<int>(k), static_cast<int>(k + 1), 3);
+      learned(NoiseKind::kGyroWalk);
     }
     for (size_t j = 0; j < problem_.segments.size(); ++j) {
       const GyroSegment& segment = problem_.segments[j];
@@ -327,6 +338,8 @@ class Builder {
                                        state_.delta[to].data(), state_.gyro_matrix.data(),
                                        state_.gyro_bias[from].data(), state_.gyro_bias[to].data()),
                from, to, 3);
+        learned(NoiseKind::kGyroWhite);
+        built_.residuals.back().segment = static_cast<int>(j);
         continue;
       }
       if (segment.interval) {
@@ -341,6 +354,8 @@ class Builder {
                                        state_.gyro_matrix.data(), state_.gyro_bias[from].data(),
                                        state_.gyro_bias[to].data(), state_.timeshift.data()),
                from, to, 3);
+        learned(NoiseKind::kGyroWhite);
+        built_.residuals.back().segment = static_cast<int>(j);
         continue;
       }
       auto* cost = new ceres::AutoDiffCostFunction<GyroResidual, 3, 3, 3, 3, 9, 3, 3>(
@@ -350,6 +365,8 @@ class Builder {
                                   state_.delta[to].data(), state_.gyro_matrix.data(),
                                   state_.gyro_bias[from].data(), state_.gyro_bias[to].data()),
           from, to, 3);
+      learned(NoiseKind::kGyroWhite);
+      built_.residuals.back().segment = static_cast<int>(j);
     }
     if (identity_matrices_) {
       holdBlock(state_.gyro_matrix.data());
@@ -403,10 +420,12 @@ class Builder {
       double* block = state_.keyframe_pv[static_cast<size_t>(pose)].data();
       addBlock(block, 6);
       ceres::Matrix A = ceres::Matrix::Zero(3, 6);
-      A.leftCols(3) = ceres::Matrix::Identity(3, 3) / settings_.camera_position_sigma_m;
+      A.leftCols(3) = ceres::Matrix::Identity(3, 3) /
+                      (settings_.camera_position_sigma_m * sigmaFactor(NoiseKind::kCameraPosition));
       ceres::Vector b = ceres::Vector::Zero(6);
       b.head(3) = p_target_m;
       record(ceres_.AddResidualBlock(new ceres::NormalPrior(A, b), nullptr, block), pose, -1, 3);
+      learned(NoiseKind::kCameraPosition);
     };
     // The bias during the links: the first with the bias prior, each next one a random walk from
     // the one before (link starts dt apart), as the rests' biases.
@@ -422,10 +441,12 @@ class Builder {
       const double dt = std::max(
           startOf(problem_.accel_links[j]) - startOf(problem_.accel_links[j - 1]), kMinWalkDt);
       auto* walk = new ceres::AutoDiffCostFunction<BiasWalkResidual, 3, 3, 3>(
-          new BiasWalkResidual{1.0 / (p.accel_bias_walk_m_s2_sqrt_s * std::sqrt(dt))});
+          new BiasWalkResidual{1.0 / (p.accel_bias_walk_m_s2_sqrt_s *
+                                      sigmaFactor(NoiseKind::kAccelWalk) * std::sqrt(dt))});
       record(ceres_.AddResidualBlock(walk, nullptr, state_.link_accel_bias[j - 1].data(),
                                      state_.link_accel_bias[j].data()),
              -1, -1, 3);
+      learned(NoiseKind::kAccelWalk);
     }
     addBlock(state_.lever_arm_m.data(), 3);
     record(ceres_.AddResidualBlock(
@@ -443,8 +464,10 @@ class Builder {
       // Per axis, [r_v, r_p]: the accelerometer's white noise integrated once and twice, and the
       // gyro's turning the integrated specific force (about g; across it, counted on every axis).
       const double T = in.duration_s;
-      const double a2 = std::pow(link.samples.accel_noise_density_m_s2_sqrt_hz, 2);
-      const double r2 = std::pow(link.samples.noise_density_rad_s_sqrt_hz * g, 2);
+      const double a2 = std::pow(
+          link.samples.accel_noise_density_m_s2_sqrt_hz * sigmaFactor(NoiseKind::kAccelWhite), 2);
+      const double r2 = std::pow(
+          link.samples.noise_density_rad_s_sqrt_hz * sigmaFactor(NoiseKind::kGyroWhite) * g, 2);
       Eigen::Matrix2d covariance;
       covariance << a2 * T + r2 * std::pow(T, 3) / 3.0,
           a2 * T * T / 2.0 + r2 * std::pow(T, 4) / 8.0,
@@ -481,6 +504,7 @@ class Builder {
                                            state_.keyframe_pv[to].data()};
       record(ceres_.AddResidualBlock(cost, loss_, blocks), static_cast<int>(from),
              static_cast<int>(to), 6);
+      learned(NoiseKind::kAccelWhite);
     }
   }
 

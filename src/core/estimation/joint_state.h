@@ -71,6 +71,8 @@ struct ResidualRecord {
   int size = 0;
   bool magnetometer = false;  ///< the pose's magnetometer residual
   int camera_link = -1;       ///< index into JointProblem::camera_links, or -1
+  int noise_kind = -1;        ///< the learned NoiseKind it measures, or -1
+  int segment = -1;           ///< index into JointProblem::segments (gyro residuals), or -1
 };
 
 /// The built problem's bookkeeping.

@@ -222,11 +222,14 @@ bool computeWhitening(const JointProblem& problem, const std::vector<GyroPreinte
   w->gyro_mean.assign(n, Eigen::Matrix3d::Zero());
   w->mag_ut.assign(n, Eigen::Matrix3d::Zero());
   w->camera.assign(n, Eigen::Matrix3d::Zero());
-  const double walk = settings.priors.gyro_bias_walk_rad_s_sqrt_s;
+  const double walk = settings.priors.gyro_bias_walk_rad_s_sqrt_s *
+                      std::sqrt(problem.noise[static_cast<size_t>(NoiseKind::kGyroWalk)]);
+  const double camera_factor = problem.noise[static_cast<size_t>(NoiseKind::kCameraMotion)];
   for (size_t k = 0; k < n; ++k) {
     const JointPose& pose = problem.poses[k];
     if (!pose.at_rest) {  // a motion node: the camera only
-      if (!whiteningMatrix(pose.cov_cam_rad2, settings.camera_sigma_floor_rad, &w->camera[k])) {
+      if (!whiteningMatrix(camera_factor * pose.cov_cam_rad2, settings.camera_sigma_floor_rad,
+                           &w->camera[k])) {
         *error = "motion node " + std::to_string(k) + ": its camera covariance is not usable";
         return false;
       }
@@ -260,7 +263,8 @@ bool computeWhitening(const JointProblem& problem, const std::vector<GyroPreinte
   }
   w->gyro_relative.assign(problem.segments.size(), Eigen::Matrix3d::Zero());
   for (size_t j = 0; j < problem.segments.size(); ++j) {
-    const double density = problem.segments[j].noise_density_rad_s_sqrt_hz;
+    const double density = problem.segments[j].noise_density_rad_s_sqrt_hz *
+                           std::sqrt(problem.noise[static_cast<size_t>(NoiseKind::kGyroWhite)]);
     const double T = segments[j].duration_s;
     // White noise integrated over T, plus the walk's deviation from the linear bias ramp (a
     // Brownian bridge: the integral's variance is walk^2 T^3 / 12).

@@ -74,9 +74,9 @@ MountChangeTest testMountChangeOnMotion(const JointProblem& problem, const Joint
   gapped.motion_frames.clear();
   for (MotionFrame frame : problem.motion_frames) {
     if (std::abs(frame.stamp_s - change_s) < half_gap) continue;
-    frame.cov_cam_rad2 *= one_mount.motion_covariance_scale;
     gapped.motion_frames.push_back(frame);
   }
+  gapped.noise = one_mount.noise.variance_factor;  // both fits under the noise learned
   gapped.timeshift_initial_s = one_mount.timeshift_cam_imu_s;
   gapped.timeshift_prior_sigma_s = kTimeshiftSigmaS;
   if (!(gapped.motion_gyro.noise_density_rad_s_sqrt_hz > 0.0)) {

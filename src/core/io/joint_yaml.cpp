@@ -56,7 +56,21 @@ std::string jointToYaml(const JointResult& j) {
   out << "  chi2: " << j.chi2 << "\n";
   out << "  dof: " << j.dof << "\n";
   out << "  chi2_p_value: " << j.chi2_p_value << "\n";
-  out << "  consistent: " << boolText(j.consistent()) << "  # chi-square p >= consistency_level\n";
+  out << "  misfit_ratio: " << j.misfitRatio()
+      << "  # sqrt(chi2/dof): residuals over their noise\n";
+  out << "  misfit_band: " << misfitBand(j.misfitRatio()) << "\n";
+  out << "  consistent: " << boolText(j.consistent())
+      << "  # chi-square p >= consistency_level, or misfit_ratio <= " << kConsistentMisfitRatio
+      << "\n";
+  out << "  measured_noise:  # the recording's noise per kind (variance components)\n";
+  for (int k = 0; k < kNoiseKinds; ++k) {
+    const auto kind = static_cast<NoiseKind>(k);
+    if (!(j.noise.stated[static_cast<size_t>(k)] > 0.0)) continue;
+    out << "    " << toString(kind) << ": {stated: " << j.noise.stated[static_cast<size_t>(k)]
+        << ", measured: " << j.noise.measured(kind)
+        << ", learned: " << boolText(j.noise.learned[static_cast<size_t>(k)])
+        << ", redundancy: " << j.noise.redundancy[static_cast<size_t>(k)] << "}\n";
+  }
   out << "  consistency_level: " << j.consistency_level << "\n";
   out << "  covariance_scale: " << j.covariance_scale << "  # chi2/dof when > 1, applied\n";
   out << "  camera_excess_sigma_deg: " << rad2deg(std::sqrt(j.camera_excess_variance_rad2))
@@ -115,19 +129,41 @@ std::string jointToYaml(const JointResult& j) {
 std::string kalibrImuYaml(const JointResult& j, double gyro_noise_density_rad_s_sqrt_hz,
                           double accel_noise_density_m_s2_sqrt_hz, double update_rate_hz,
                           const std::string& rostopic) {
+  // Each density: as the recording's residuals measured it (variance components), else the
+  // scatter at the rests, else the noise the estimate was given (never 0).
+  const auto pick = [&](NoiseKind kind, double at_rests, double fallback, std::string* source) {
+    const auto k = static_cast<size_t>(kind);
+    if (j.noise.learned[k] && j.noise.stated[k] > 0.0) {
+      *source = "measured on the recording (variance components)";
+      return j.noise.measured(kind);
+    }
+    if (at_rests > 0.0) {
+      *source = "the scatter at the rests";
+      return at_rests;
+    }
+    *source = j.noise.stated[k] > 0.0 ? "as stated (not measured by this recording)"
+                                      : "a MEMS default (not measured by this recording)";
+    return j.noise.stated[k] > 0.0 ? j.noise.stated[k] : fallback;
+  };
+  std::string source[4];
+  const double accel_white =
+      pick(NoiseKind::kAccelWhite, accel_noise_density_m_s2_sqrt_hz, 2.0e-3, &source[0]);
+  const double accel_walk = pick(NoiseKind::kAccelWalk, 0.0, 2.0e-4, &source[1]);
+  const double gyro_white =
+      pick(NoiseKind::kGyroWhite, gyro_noise_density_rad_s_sqrt_hz, 1.7e-4, &source[2]);
+  const double gyro_walk = pick(NoiseKind::kGyroWalk, 0.0, 4.0e-6, &source[3]);
   std::ostringstream out;
-  out << std::setprecision(9);
-  out << "# Kalibr imu.yaml (noise densities measured at the recording's rests; random walks are\n"
-         "# not measured by a calibration this short: Kalibr's defaults for a MEMS unit, inflate\n"
-         "# as Kalibr advises). Extra keys: the intrinsics of camera_imu_alignment's joint "
+  out << std::setprecision(6);
+  out << "# Kalibr imu.yaml. Extra keys: the intrinsics of camera_imu_alignment's joint "
          "estimate.\n";
-  out << "accelerometer_noise_density: " << accel_noise_density_m_s2_sqrt_hz
-      << "  # m/s^2/sqrt(Hz)\n";
-  out << "accelerometer_random_walk: 0.0002  # m/s^3/sqrt(Hz)\n";
-  out << "gyroscope_noise_density: " << gyro_noise_density_rad_s_sqrt_hz << "  # rad/s/sqrt(Hz)\n";
-  out << "gyroscope_random_walk: 4.0e-06  # rad/s^2/sqrt(Hz)\n";
+  out << "accelerometer_noise_density: " << accel_white << "  # m/s^2/sqrt(Hz), " << source[0]
+      << "\n";
+  out << "accelerometer_random_walk: " << accel_walk << "  # m/s^3/sqrt(Hz), " << source[1] << "\n";
+  out << "gyroscope_noise_density: " << gyro_white << "  # rad/s/sqrt(Hz), " << source[2] << "\n";
+  out << "gyroscope_random_walk: " << gyro_walk << "  # rad/s^2/sqrt(Hz), " << source[3] << "\n";
   out << "rostopic: " << rostopic << "\n";
   out << "update_rate: " << update_rate_hz << "  # Hz\n";
+  out << std::setprecision(9);
   out << jointToYaml(j);
   return out.str();
 }

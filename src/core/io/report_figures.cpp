@@ -147,7 +147,9 @@ ReportFigures reportFigures(const ReportInput& in) {
 std::string jointConsistencyText(const JointResult& j) {
   const double per_dof = j.dof > 0 ? j.chi2 / j.dof : 0.0;
   return "chi2/dof " + fixed(per_dof, 2) + " (" + std::to_string(j.dof) + " dof, p " +
-         fixed(j.chi2_p_value, 3) + ": " + (j.consistent() ? "consistent" : "INCONSISTENT") + ")";
+         fixed(j.chi2_p_value, 3) + "; residuals " + fixed(j.misfitRatio(), 2) + "x their noise, " +
+         misfitBand(j.misfitRatio()) + ": " + (j.consistent() ? "consistent" : "INCONSISTENT") +
+         ")";
 }
 
 std::string truthErrorText(const TruthError& e) {

@@ -185,8 +185,9 @@ void drawMotionPanel(cv::Mat& img, const cv::Rect& panel, const ReportInput& in)
       " rest(s), " + std::to_string(joint->motion_nodes) + " motion nodes over " +
       fixed(m.excitation_duration_s, 1) + " s); rotation about camera x, y, z " +
       report_text::fixedList(rad2deg(1.0) * m.excitation_rad, 0) + " deg" +
-      (joint->motion_covariance_scale > 1.0
-           ? "; motion frames' covariance scaled by " + fixed(joint->motion_covariance_scale, 1)
+      (joint->noise.learned[static_cast<size_t>(NoiseKind::kCameraMotion)]
+           ? "; camera noise " + fixed(joint->noise.sigmaFactor(NoiseKind::kCameraMotion), 2) +
+                 "x stated, gyro " + fixed(joint->noise.sigmaFactor(NoiseKind::kGyroWhite), 2) + "x"
            : "") +
       (m.frames_dropped > 0 ? "; " + std::to_string(m.frames_dropped) +
                                   " frame(s) dropped: reprojection far beyond the recording's"

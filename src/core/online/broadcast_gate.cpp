@@ -85,7 +85,11 @@ GateOutcome judgeEstimate(const AlignmentResult& r, std::size_t window_poses,
   why.precision(3);
   const double sigma = r.quality.std_dev_deg.maxCoeff();
   const bool joint = r.joint.has_value();
-  out.consistent = joint && r.joint->ok && r.joint->chi2_p_value >= settings.consistency_level;
+  if (joint) {  // the result's own rule (JointResult::consistent) at the gate's level
+    JointResult judged = *r.joint;
+    judged.consistency_level = settings.consistency_level;
+    out.consistent = judged.consistent();
+  }
   out.determined = r.status == SolveStatus::kOk && r.R_cam_imu.allFinite() &&
                    r.quality.std_dev_deg.allFinite() && sigma <= settings.max_std_dev_deg;
   if (r.status != SolveStatus::kOk) {
@@ -98,10 +102,12 @@ GateOutcome judgeEstimate(const AlignmentResult& r, std::size_t window_poses,
   } else if (joint && !r.joint->ok) {
     why << "the joint estimate failed: " << r.joint->message;
   } else if (joint && !out.consistent) {
-    why << "the data do not fit one mount with the modelled noise: chi2/dof "
+    why << "the data do not fit one mount: the residuals are " << r.joint->misfitRatio()
+        << "x their measured noise (" << misfitBand(r.joint->misfitRatio()) << "; consistent up to "
+        << kConsistentMisfitRatio << "x), chi2/dof "
         << (r.joint->dof > 0 ? r.joint->chi2 / r.joint->dof : 0.0) << ", p "
         << r.joint->chi2_p_value << " < consistency_level " << settings.consistency_level
-        << " (IMU errors beyond the imu_prior_* values, a bad pose, or a mount that moved)";
+        << " (a bad pose, a mount that moved, or IMU errors beyond the imu_prior_* values)";
   } else if (!joint && !(r.quality.residual_rms_deg <= settings.max_residual_deg)) {
     why << "residual RMS " << r.quality.residual_rms_deg << " deg > max_residual_deg "
         << settings.max_residual_deg;
