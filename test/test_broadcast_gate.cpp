@@ -103,6 +103,27 @@ TEST(BroadcastGate, JointEstimateJudgedByChiSquareNotByThePairResidual) {
             std::string::npos);
 }
 
+TEST(BroadcastGate, MotionStandsInForPosesOnlyWhenItIsLongAndTurnsEveryAxis) {
+  const OnlineSettings s;  // min_motion_s 15, min_motion_rotation_deg 180
+  AlignmentResult motion = jointResult(0.05, turned(0), 0.3);
+  motion.joint->motion_nodes = 60;
+  motion.joint->motion.excitation_duration_s = 6.0;  // a few seconds of waving
+  motion.joint->motion.excitation_rad = Eigen::Vector3d::Constant(deg2rad(300.0));
+  const GateOutcome short_motion = judgeEstimate(motion, 0, s, std::nullopt, false);
+  EXPECT_EQ(short_motion.decision, GateDecision::kReject);
+  EXPECT_FALSE(short_motion.enough_data);
+  EXPECT_NE(short_motion.why.find("min_motion_s 15"), std::string::npos) << short_motion.why;
+  motion.joint->motion.excitation_duration_s = 20.0;
+  motion.joint->motion.excitation_rad(1) = deg2rad(100.0);  // camera y barely turned
+  const GateOutcome one_axis_short = judgeEstimate(motion, 0, s, std::nullopt, false);
+  EXPECT_EQ(one_axis_short.decision, GateDecision::kReject);
+  EXPECT_NE(one_axis_short.why.find("min_motion_rotation_deg 180"), std::string::npos);
+  motion.joint->motion.excitation_rad(1) = deg2rad(200.0);
+  const GateOutcome enough = judgeEstimate(motion, 0, s, std::nullopt, false);
+  EXPECT_EQ(enough.decision, GateDecision::kBroadcast) << enough.why;
+  EXPECT_TRUE(enough.enough_data);
+}
+
 TEST(BroadcastGate, NoSilentRegressionUnlessMorePosesOrADifferentMount) {
   const OnlineSettings s;
   const BroadcastEstimate published = broadcastOf(jointResult(0.05, turned(0.0), 0.5), 10);

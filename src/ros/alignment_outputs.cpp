@@ -364,6 +364,7 @@ void AlignmentWrapper::Impl::diagnose(diagnostic_updater::DiagnosticStatusWrappe
         (snap.broadcast ? "; the broadcast calibration is from an earlier window" : std::string()));
   }
   if (!save_error.empty()) problems.push_back(save_error);
+  if (!snap.broadcast_warning.empty()) problems.push_back(snap.broadcast_warning);
   std::string summary = std::string(toString(state)) + ": " + snap.message;
   for (const std::string& p : problems) {
     if (summary.find(p) == std::string::npos) summary += "; " + p;

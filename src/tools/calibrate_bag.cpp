@@ -370,6 +370,13 @@ int run(const cia::CliArgs& args) {
     return check->consistent ? kExitOk : kExitQualityGate;  // a check writes no result
   }
   if (!gates_passed) {
+    // Too little data in the window (and no remount cut it): not enough information, not a
+    // failed gate.
+    if (snap.latest && !snap.latest->gate.enough_data && snap.remount_events.empty()) {
+      std::cerr << "calibrate_bag: not enough information (see 'verdict:'): "
+                << snap.latest->gate.why << "; nothing written\n";
+      return kExitNotEnoughInformation;
+    }
     std::cerr << "calibrate_bag: the estimate fails the quality gates (see 'verdict:'); not "
                  "written to --output / --imu-yaml\n";
     return kExitQualityGate;

@@ -115,6 +115,10 @@ struct MountChangeTest {
   /// of the motion left out; the new mount's data start motion_gap_s / 2 after it. NaN: a change
   /// between rests (first_pose_after) or none.
   double change_stamp_s = std::numeric_limits<double>::quiet_NaN();
+  /// testMountChangeOnMotion: how much more the recording's own unchanged segments differ than
+  /// their 1-sigma says (>= 1; 1 when not measured), the least scale its F statistic is judged
+  /// at: measured when the test is significant against the noise alone.
+  double segment_scatter = 1.0;
 };
 
 /// Tests `problem` (its mount_change_pose ignored) against `one_mount`, the joint estimate of
@@ -134,11 +138,24 @@ MountChangeTest testMountChange(const JointProblem& problem, const JointResult& 
 /// locates it. Whether: the motion within motion_gap_s around it is left out and the one-mount
 /// and two-mount fits (JointProblem::mount_change_stamp_s) compared as in testMountChange (F
 /// statistic, p Bonferroni-corrected for the window's possible locations, one per gap width). A
+/// A change significant against the noise alone is judged again with the scale raised to the
+/// recording's own segment scatter (MountChangeTest::segment_scatter: each side's two halves
+/// solved alone, under the noise learned, against their covariances): a remount must explain the
+/// data better than an unchanged recording's segments differ from each other. A
 /// significant change within min_motion_s + motion_gap_s of either end of the motion is pending:
 /// a change in the newest seconds is located at the latest split allowed, before where it was.
 MountChangeTest testMountChangeOnMotion(const JointProblem& problem, const JointResult& one_mount,
                                         const JointSettings& joint_settings,
                                         const MountChangeSettings& settings);
+
+/// How much more a motion recording's own segments differ than their 1-sigma says, under the
+/// noise the problem carries (JointProblem::noise; learned by the estimate): the motion before
+/// split_s - half_gap and after split_s + half_gap each cut into two halves, each half solved
+/// alone, and the halves' differences against their summed covariances, sum d^T (C_a + C_b)^-1 d
+/// / (3 x sides), at least 1 (1 when it cannot be measured: halves under 2 s, rests in the
+/// problem, a failed solve). About 1 where the model fits the recording.
+double segmentScatter(const JointProblem& problem, double split_s, double half_gap,
+                      const JointSettings& settings, const Eigen::Matrix3d& R_cam_imu_start);
 
 /// P(F > f) for an F(d1, d2) distribution (1 when an argument is not usable).
 double fisherUpperTail(double f, int d1, int d2);

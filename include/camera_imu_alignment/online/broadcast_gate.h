@@ -28,6 +28,10 @@ struct GateOutcome {
   bool consistent = false;
   /// determined: solved, observable and finite with its largest 1-sigma <= max_std_dev_deg.
   bool determined = false;
+  /// False when the window holds too little to judge (fewer than min_poses poses and too little
+  /// motion, enoughMotion): not a failed quality gate but missing information (calibrate_bag's
+  /// exit 3).
+  bool enough_data = true;
   /// kKeep within min_change_deg, with a smaller 1-sigma than the broadcast estimate's: the tf
   /// stays, but the saved file and the broadcast 1-sigma become this estimate's.
   bool refines_broadcast = false;
@@ -47,10 +51,11 @@ struct GateOutcome {
 ///     remount.level);
 ///   min_change_deg: a change smaller than that is not re-broadcast (refines_broadcast when it is
 ///     more precise).
-/// A joint estimate with at least this many motion nodes (about 5 s of motion at the default
-/// node spacing) stands in for min_poses: a recording without rests has no poses to count, and
-/// its statistical gates (consistency, 1-sigma) decide.
-constexpr int kMinMotionNodes = 50;
+/// A joint estimate with motion stands in for min_poses when its window holds min_motion_s of
+/// motion that turned the camera min_motion_rotation_deg about each of its axes (MotionFigures):
+/// a recording without rests has no poses to count, and its statistical gates (consistency,
+/// 1-sigma) decide once the motion has shown its noise.
+bool enoughMotion(const JointResult& joint, const OnlineSettings& settings);
 
 GateOutcome judgeEstimate(const AlignmentResult& result, std::size_t window_poses,
                           const OnlineSettings& settings,

@@ -153,6 +153,10 @@ struct CalibrationSnapshot {
   std::vector<RemountEvent> remount_events;    ///< since the start or the last reset (newest 100)
   /// The latest estimate against the broadcast one (when both exist): is the tf still right?
   std::optional<CalibrationCheck> check;
+  /// "" unless the latest estimate disagrees with the broadcast tf beyond the check's level and
+  /// the gates did not let it replace the tf: what is wrong and why it stayed (diagnostics WARN,
+  /// and the status message says it).
+  std::string broadcast_warning;
   int remounts = 0;
   CalibrationProgress progress;
 

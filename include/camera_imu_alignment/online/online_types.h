@@ -26,6 +26,12 @@ const char* toString(CalibrationState state);
 /// Quality gates, change detection and capture policy (config/default.yaml documents each key).
 struct OnlineSettings {
   int min_poses = 3;  ///< stationary poses in the window before anything is broadcast
+  /// A recording without enough poses (continuous motion) stands in for min_poses with this
+  /// much motion in the window (s, the motion frames' intervals summed) that turned the camera at
+  /// least min_motion_rotation_deg about each of its axes: a first broadcast from a few seconds of
+  /// motion would rest on noise the recording has not yet shown (its 1-sigma too).
+  double min_motion_s = 15.0;
+  double min_motion_rotation_deg = 180.0;
   /// Largest 1-sigma (deg) of a broadcast estimate: the joint estimate's own covariance, scaled
   /// by chi2/dof when the residuals exceed their noise.
   double max_std_dev_deg = 0.5;

@@ -29,6 +29,10 @@ const std::vector<Key>& onlineKeys() {
   static const std::vector<Key> table = {
       number<int>("min_poses", CIA_MEMBER(min_poses), atLeast(2), "",
                   "gate: stationary poses in the window before broadcasting"),
+      number<double>("min_motion_s", CIA_MEMBER(min_motion_s), atLeast(0.0), "s",
+                     "gate without min_poses poses: motion in the window before broadcasting"),
+      number<double>("min_motion_rotation_deg", CIA_MEMBER(min_motion_rotation_deg), atLeast(0.0),
+                     "deg", "gate with min_motion_s: rotation about each camera axis needed"),
       number<double>("max_std_dev_deg", CIA_MEMBER(max_std_dev_deg), positive, "deg",
                      "gate: largest 1-sigma about a camera axis of a broadcast estimate"),
       number<double>("consistency_level", CIA_MEMBER(consistency_level), probability, "",

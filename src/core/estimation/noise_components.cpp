@@ -27,13 +27,13 @@ namespace {
 constexpr int kMaxDenseParameters = 400;
 /// Hutchinson probes (Rademacher vectors over every residual) otherwise.
 constexpr int kProbes = 32;
-/// A block beyond this quantile of chi-square (its size) at its kind's robust scale is an
-/// outlier of that kind's components.
-constexpr double kOutlierQuantile = 0.999;
+/// Quantile of chi-square (a block's size) a block's squared norm is capped at in its kind's
+/// chi-square.
+constexpr double kCapQuantile = 0.9999;
 /// Ridge on H (relative to its largest diagonal entry): the gauge directions no residual sees.
 constexpr double kRidge = 1e-12;
-/// The camera's noise is not taken below this fraction of the stated variance by the split.
-constexpr double kMinCameraFactor = 0.1;
+/// The camera's noise is not taken below the stated variance by the split.
+constexpr double kMinCameraFactor = 1.0;
 
 /// Quantile q of chi-square with `dof` degrees of freedom (cached: few sizes occur).
 double chiSquareQuantile(int dof, double q) {
@@ -135,37 +135,15 @@ bool measureNoiseComponents(ceres::Problem* ceres_problem, const BuiltProblem& b
       if (it != block_of.end()) blocks[it->second].leverage += leverage[row];
     }
   }
-  // Outlier blocks (a bad stretch, a moved object) leave the kind's components: beyond the
-  // chi-square quantile kOutlierQuantile of its size at the kind's robust scale (the median
-  // block over its median, for the share the fit leaves it).
-  std::array<std::vector<double>, kNoiseKinds> ratios;
-  std::array<double, kNoiseKinds> kept_residuals{}, kept_leverage{};
-  for (const Block& block : blocks) {
-    const double keep = 1.0 - std::min(0.99, block.leverage / block.size);
-    ratios[static_cast<size_t>(block.kind)].push_back(block.squared / keep /
-                                                      chiSquareQuantile(block.size, 0.5));
-  }
-  std::array<double, kNoiseKinds> scale{};
-  for (size_t k = 0; k < ratios.size(); ++k) {
-    std::vector<double>& v = ratios[k];
-    if (v.empty()) continue;
-    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    scale[k] = std::max(v[v.size() / 2], 1e-12);
-  }
+  // Each block's squared norm capped at kCapQuantile of chi-square with its size: a gross outlier
+  // (a glitch, a moved object) counts as a large residual, not as its own size.
   for (const Block& block : blocks) {
     const auto k = static_cast<size_t>(block.kind);
-    const double keep = 1.0 - std::min(0.99, block.leverage / block.size);
     noise->residuals[k] += block.size;
-    if (block.squared / keep > scale[k] * chiSquareQuantile(block.size, kOutlierQuantile)) {
-      continue;
-    }
-    noise->chi2[k] += block.squared;
-    kept_residuals[k] += block.size;
-    kept_leverage[k] += block.leverage;
+    noise->chi2[k] += std::min(block.squared, chiSquareQuantile(block.size, kCapQuantile));
+    noise->redundancy[k] += block.size - block.leverage;
   }
-  for (size_t k = 0; k < kept_residuals.size(); ++k) {
-    noise->redundancy[k] = std::max(0.0, kept_residuals[k] - kept_leverage[k]);
-  }
+  for (double& r : noise->redundancy) r = std::max(0.0, r);
   return true;
 }
 
@@ -299,10 +277,12 @@ constexpr std::array<std::array<int, 3>, 2> kPooled = {
      {static_cast<int>(NoiseKind::kCameraPosition), static_cast<int>(NoiseKind::kAccelWhite),
       static_cast<int>(NoiseKind::kAccelWalk)}}};
 
-/// The IMU's white noise is not taken below its stated density.
+/// The IMU's white noise and the camera's orientation noise are not taken below their stated
+/// values (a datasheet density, a PnP covariance: what a sensor does at best).
 double floorOf(size_t kind) {
   return kind == static_cast<size_t>(NoiseKind::kGyroWhite) ||
-                 kind == static_cast<size_t>(NoiseKind::kAccelWhite)
+                 kind == static_cast<size_t>(NoiseKind::kAccelWhite) ||
+                 kind == static_cast<size_t>(NoiseKind::kCameraMotion)
              ? 1.0
              : 1.0 / kMaxNoiseFactor;
 }

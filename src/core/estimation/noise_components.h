@@ -6,12 +6,11 @@
 // its redundancy, the number of its residuals minus the trace of its share of the hat matrix,
 //   r_k = n_k - tr(H^-1 J_k^T J_k),  H = J^T J over the free parameters (tangent space),
 // the degrees of freedom the kind keeps after the fit (Foerstner's variance-component
-// estimation), both over the kind's blocks less its outliers (beyond the 99.9 % quantile of
-// chi-square at the kind's robust scale, the median block's; so that a bad stretch does not raise
-// the noise of the rest). The trace is exact (dense inverse) for small problems and a Hutchinson
-// estimate with Rademacher probes otherwise: for a trace t of a matrix with eigenvalues in [0, 1]
-// one probe has a relative standard deviation below sqrt(2 / t), so that 32 probes give a
-// thousand-residual kind's redundancy to about 1 %.
+// estimation), each block's squared norm capped at the 99.99 % quantile of chi-square with its
+// size (a gross outlier counts as a large residual, not as its own size). The trace is exact (dense
+// inverse) for small problems and a Hutchinson estimate with Rademacher probes otherwise: for a
+// trace t of a matrix with eigenvalues in [0, 1] one probe has a relative standard deviation below
+// sqrt(2 / t), so that 32 probes give a thousand-residual kind's redundancy to about 1 %.
 #pragma once
 
 #include <ceres/problem.h>

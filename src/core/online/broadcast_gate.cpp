@@ -49,6 +49,12 @@ std::optional<Difference> differenceOf(const AlignmentResult& estimate,
 
 }  // namespace
 
+bool enoughMotion(const JointResult& joint, const OnlineSettings& settings) {
+  const MotionFigures& m = joint.motion;
+  return joint.motion_nodes > 0 && m.excitation_duration_s >= settings.min_motion_s &&
+         rad2deg(m.excitation_rad.minCoeff()) >= settings.min_motion_rotation_deg;
+}
+
 double differenceSignificance(const AlignmentResult& result, const BroadcastEstimate& broadcast) {
   if (!broadcast.covariance_rad2) return 1.0;
   const std::optional<Difference> d = differenceOf(result, broadcast);
@@ -97,8 +103,16 @@ GateOutcome judgeEstimate(const AlignmentResult& r, std::size_t window_poses,
   } else if (!r.R_cam_imu.allFinite() || !r.quality.std_dev_deg.allFinite()) {
     why << "estimate or 1-sigma not finite";  // never reaches the tf or a file
   } else if (window_poses < static_cast<std::size_t>(settings.min_poses) &&
-             !(joint && r.joint->motion_nodes >= kMinMotionNodes)) {
+             !(joint && enoughMotion(*r.joint, settings))) {
+    out.enough_data = false;
     why << window_poses << " poses in the window, min_poses is " << settings.min_poses;
+    if (joint && r.joint->motion_nodes > 0) {
+      const MotionFigures& m = r.joint->motion;
+      why << "; motion " << m.excitation_duration_s << " s (min_motion_s " << settings.min_motion_s
+          << "), rotation about camera x, y, z " << rad2deg(m.excitation_rad(0)) << ", "
+          << rad2deg(m.excitation_rad(1)) << ", " << rad2deg(m.excitation_rad(2))
+          << " deg (min_motion_rotation_deg " << settings.min_motion_rotation_deg << ")";
+    }
   } else if (joint && !r.joint->ok) {
     why << "the joint estimate failed: " << r.joint->message;
   } else if (joint && !out.consistent) {

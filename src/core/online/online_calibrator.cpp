@@ -569,6 +569,17 @@ CalibrationSnapshot OnlineCalibrator::snapshot(SnapshotContents contents) const 
   s.remount_events = c.remount_events;
   if (c.last_estimate && c.broadcast) {
     s.check = checkCalibration(c.last_estimate->result, *c.broadcast, c.settings.consistency_level);
+    if (s.check && !s.check->consistent && !s.latest_is_broadcast) {
+      char buffer[160];
+      std::snprintf(buffer, sizeof(buffer),
+                    "the broadcast tf is %.2f deg (%.1f sigma) from the latest estimate, which the "
+                    "gates kept back: ",
+                    s.check->error_deg, s.check->sigmas);
+      s.broadcast_warning =
+          buffer + (c.last_estimate->gate.why.empty() ? std::string("no reason given")
+                                                      : c.last_estimate->gate.why);
+      s.message += "; " + s.broadcast_warning;
+    }
   }
   s.remounts = c.remounts;
   // The vertical at the newest rest in the camera frame: R_world_imu's z is up (gravity).
