@@ -140,17 +140,16 @@ TEST(CalibrateBag, ImuGradesWithTheDefaultPriors) {
   removeBag(consumer);
   const std::string noisy = simulate("noisy", "--scenario noisy_consumer --seed 55");
   const Calibration n = calibrate(noisy, "--truth " + stem(noisy) + ".truth.yaml");
-  // Flagged: the nodelet's gates refuse an inconsistent estimate, so calibrate_bag exits 4 and
-  // writes nothing, saying which gate ...
-  EXPECT_EQ(n.run.exit_code, 4) << n.run.err << n.run.out;
-  EXPECT_NE(n.run.out.find("verdict: FAILED: the data do not fit one mount"), std::string::npos)
-      << n.run.out;
-  EXPECT_NE(n.run.out.find("INCONSISTENT"), std::string::npos) << n.run.out;
-  EXPECT_FALSE(std::filesystem::exists(temp("result.yaml")));
-  // ... while the estimate it prints is still within 1 deg of the truth.
+  // The consumer priors understate the noisy unit's errors: the chi-square test alone rejects
+  // the estimate (p 1e-7 on 559 dof), but the residuals are only 1.13x their noise as the
+  // recording measured it and the answer is within its 1-sigma (measured 0.046 deg, |z| <= 0.40):
+  // the effect size accepts it, and the summary says both.
+  EXPECT_EQ(n.run.exit_code, 0) << n.run.err << n.run.out;
+  EXPECT_NE(n.run.out.find("x their noise, good: consistent"), std::string::npos) << n.run.out;
   const auto at = n.run.out.find("error to ");
   ASSERT_NE(at, std::string::npos) << n.run.out;
-  EXPECT_LT(std::stod(n.run.out.substr(n.run.out.find(": ", at) + 2)), 1.0) << n.run.out;
+  EXPECT_LT(std::stod(n.run.out.substr(n.run.out.find(": ", at) + 2)), 0.5) << n.run.out;
+  EXPECT_EQ(n.run.out.find("(beyond 3 sigma)"), std::string::npos) << n.run.out;
   // With the unit's own priors (test/data/noisy_imu.yaml) the same bag is consistent: measured
   // seeds 53-55 0.13-0.58 deg, |z| <= 2.15, p 0.06-0.81 (seed 55: 0.13 deg).
   const Calibration own = calibrate(noisy, "--config " TEST_DATA_DIR "/noisy_imu.yaml");

@@ -113,9 +113,16 @@ TEST(CameraPoseBag, AWavingBagIsCalibratedFromTheMotionAlone) {
   // The motion alone (no rests) calibrates: R_cam_imu within its reported 3 sigma (the consumer
   // gyro's misalignment prior, ~0.4 deg per axis, without rests) and the time offset (Kalibr's
   // sign: the camera stamps are late by 15 ms, t_imu = t_cam - 0.015).
+  // The bag holds 10 s of motion: below min_motion_s (15 s by default: exit 3, "not enough
+  // information"); the setting lets a short recording through.
   const std::string stem = test::bagStem(bag);
-  const test::ToolRun run = test::runTool(kCalibrate + " --quiet --bag " + bag + " --truth " +
-                                          stem + ".truth.yaml --output " + stem + ".out.yaml");
+  const std::string short_motion = test::writeTempFile("short_motion.yaml", "min_motion_s: 5\n");
+  const test::ToolRun refused = test::runTool(kCalibrate + " --quiet --bag " + bag);
+  EXPECT_EQ(refused.exit_code, 3) << refused.err << refused.out;
+  EXPECT_NE(refused.err.find("(min_motion_s 15)"), std::string::npos) << refused.err;
+  const test::ToolRun run =
+      test::runTool(kCalibrate + " --quiet --bag " + bag + " --config " + short_motion +
+                    " --truth " + stem + ".truth.yaml --output " + stem + ".out.yaml");
   EXPECT_EQ(run.exit_code, 0) << run.err << run.out;
   // Every pose but the first (stamped before the first IMU sample) is a motion frame.
   EXPECT_NE(run.err.find("51 camera poses; 0 stationary rests, 0 poses, 50 camera orientations "
