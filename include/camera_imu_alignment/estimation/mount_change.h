@@ -148,15 +148,6 @@ MountChangeTest testMountChangeOnMotion(const JointProblem& problem, const Joint
                                         const JointSettings& joint_settings,
                                         const MountChangeSettings& settings);
 
-/// How much more a motion recording's own segments differ than their 1-sigma says, under the
-/// noise the problem carries (JointProblem::noise; learned by the estimate): the motion before
-/// split_s - half_gap and after split_s + half_gap each cut into two halves, each half solved
-/// alone, and the halves' differences against their summed covariances, sum d^T (C_a + C_b)^-1 d
-/// / (3 x sides), at least 1 (1 when it cannot be measured: halves under 2 s, rests in the
-/// problem, a failed solve). About 1 where the model fits the recording.
-double segmentScatter(const JointProblem& problem, double split_s, double half_gap,
-                      const JointSettings& settings, const Eigen::Matrix3d& R_cam_imu_start);
-
 /// P(F > f) for an F(d1, d2) distribution (1 when an argument is not usable).
 double fisherUpperTail(double f, int d1, int d2);
 

@@ -58,12 +58,5 @@ AccelLinkIntegral integrateAccelLink(const GyroStream& samples, double t_from_s,
 /// left out, the mount change); motion nodes are counted in motion_nodes.
 void mapResultToCaller(const ExpandedProblem& expanded, JointResult* result);
 
-/// Motion frames' covariance re-weighting (JointEstimator::solve): their covariance is scaled by
-/// chi2/dof, first when it exceeds kMotionReweightAbove, then while it exceeds
-/// kMotionReweightSettled, in at most kMaxMotionReweights more solves.
-constexpr double kMotionReweightAbove = 2.0;
-constexpr double kMotionReweightSettled = 1.1;
-constexpr int kMaxMotionReweights = 4;
-
 }  // namespace joint
 }  // namespace camera_imu_alignment

@@ -41,14 +41,10 @@ int stepLocation(const std::vector<double>& stamps, const std::vector<Eigen::Vec
   return best;
 }
 
-}  // namespace
-
 /// Motion each half of a side needs for the scatter of the recording's own segments (s).
-namespace {
 constexpr double kMinHalfS = 2.0;
-}  // namespace
 
-// How much more the recording's own segments differ than their 1-sigma says, under the noise
+/// How much more the recording's own segments differ than their 1-sigma says, under the noise
 // learned: each side of the split cut into two halves, each half solved alone (its R_cam_imu and
 // covariance), and the halves' differences judged against their summed covariances,
 // phi = sum_sides d^T (C_a + C_b)^-1 d / (3 x sides). Without a change both sides' halves
@@ -93,6 +89,8 @@ double segmentScatter(const JointProblem& gapped, double split_s, double half_ga
   }
   return compared > 0 ? std::max(1.0, sum / (3.0 * compared)) : 1.0;
 }
+
+}  // namespace
 
 MountChangeTest testMountChangeOnMotion(const JointProblem& problem, const JointResult& one_mount,
                                         const JointSettings& joint_settings,
