@@ -6,6 +6,8 @@
 //   BM_WindowSolve: the worker's job on a full 30-pose window: the pair estimators, the joint
 //     estimate and the change-point test (4 two-mount solves): the latency from a pose to its
 //     estimate.
+//   BM_WindowSolveTwelveRests: the same job on the default recording (12 rests, consumer unit) with
+//     the camera's orientations during the motion between the rests (motion nodes) in the window.
 // Data: the simulator's long_run scenario (40 poses, consumer IMU grade), camera orientations
 // given with 0.03 deg noise (no images: detection is benchmarked in bench_pipeline).
 #include <benchmark/benchmark.h>
@@ -127,6 +129,34 @@ void BM_WindowSolve(benchmark::State& state) {
   state.counters["poses"] = poses;
 }
 BENCHMARK(BM_WindowSolve)->Unit(benchmark::kMillisecond);
+
+void BM_WindowSolveTwelveRests(benchmark::State& state) {
+  static const std::unique_ptr<sim::SimulationRun> run = [] {
+    sim::SimulationConfig c;
+    c.seed = 5;
+    sim::applyScenario("nominal", &c);
+    sim::applyImuGrade(sim::ImuGrade::kConsumer, &c);
+    return std::make_unique<sim::SimulationRun>(c);
+  }();
+  cia::PipelineSettings s;
+  s.joint = cia::test::jointSettingsFor(run->config);
+  static const cia::WindowSnapshot window = [&] {
+    return cia::test::feedWithoutImages(*run, s, 0.03)->snapshot();
+  }();
+  for (auto _ : state) {
+    const cia::AlignmentResult result = cia::solveWindow(window, s);
+    if (!result.joint || !result.joint->ok) {
+      state.SkipWithError("the joint estimate failed");
+      break;
+    }
+    const cia::MountChangeTest test =
+        cia::testMountChange(window.joint, *result.joint, s.joint, cia::MountChangeSettings{});
+    benchmark::DoNotOptimize(test.p_value);
+  }
+  state.counters["poses"] = static_cast<double>(window.pose_indices.size());
+  state.counters["motion_nodes"] = static_cast<double>(window.joint.motion_frames.size());
+}
+BENCHMARK(BM_WindowSolveTwelveRests)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -38,6 +38,9 @@ void BagProgress::update(double t, const OnlineCalibrator& calibrator, bool forc
   std::ostringstream line;
   line << "[calibrate_bag] " << std::setw(3) << std::min(percent, 100) << "% of bag time, "
        << snap.rests.size() << " rests, " << snap.poses.size() << " poses";
+  if (snap.inputs.motion_frames > 0) {
+    line << ", " << snap.inputs.motion_frames << " camera orientations during motion";
+  }
   if (snap.latest) {
     const AlignmentResult& result = snap.latest->result;
     line << ", R_cam_imu " << rollPitchYawText(result.R_cam_imu, 2) << " +- " << std::fixed

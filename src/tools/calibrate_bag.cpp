@@ -10,6 +10,7 @@
 #include <rosbag/view.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -260,7 +261,18 @@ int run(const cia::CliArgs& args) {
   }
 
   // --- Verdict.
+  if (!args.has("--quiet")) {
+    std::cerr << "[calibrate_bag] final solve over the whole recording ..." << std::endl;
+  }
+  const auto solve_start = std::chrono::steady_clock::now();
   const cia::CalibrateOutcome outcome = calibrator->calibrateNow(false);
+  if (!args.has("--quiet")) {
+    std::cerr
+        << "[calibrate_bag] final solve done in " << std::fixed << std::setprecision(1)
+        << std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count()
+        << " s" << std::endl;
+    std::cerr.unsetf(std::ios::floatfield);
+  }
   const cia::CalibrationSnapshot snap = calibrator->snapshot(cia::SnapshotContents::kWithHistory);
   std::cerr << "[calibrate_bag] read " << snap.inputs.imu_samples << " IMU, "
             << snap.inputs.magnetic_samples << " magnetometer samples, "

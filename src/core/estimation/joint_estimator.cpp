@@ -431,7 +431,7 @@ int worstMagnetometerPose(const JointResult& result) {
 /// unseen, as the check said.
 JointResult screenMagnetometer(const JointProblem& problem,
                                const Eigen::Matrix3d& R_cam_imu_initial,
-                               const JointSettings& settings) {
+                               const JointSettings& settings, JointProblem* as_used = nullptr) {
   JointProblem unflagged = problem;
   int flagged = 0;
   for (JointPose& pose : unflagged.poses) {
@@ -442,6 +442,7 @@ JointResult screenMagnetometer(const JointProblem& problem,
     pose.mag_flagged = false;
   }
   if (flagged == 0 || settings.use_magnetometer == MagnetometerUse::kOff) {
+    if (as_used) *as_used = unflagged;
     return solveMatrices(unflagged, R_cam_imu_initial, settings);
   }
   // The hard iron counts as calibrated when the data, not its prior, determine it.
@@ -471,11 +472,13 @@ JointResult screenMagnetometer(const JointProblem& problem,
         result.notes.push_back("magnetometer at pose " + std::to_string(k) +
                                " left out: its field does not fit the calibrated iron (disturbed)");
       }
+      if (as_used) *as_used = screened;
       return result;
     }
     screened.poses[worst].mag_mean_t.reset();
     left_out.push_back(worst);
   }
+  if (as_used) *as_used = unflagged;
   JointResult result = solveMatrices(unflagged, R_cam_imu_initial, settings);
   result.notes.push_back("magnetometer: " + std::to_string(flagged) +
                          " rest(s) flagged by the raw field check left out (the iron could not be "
@@ -515,11 +518,16 @@ constexpr double kExcessSettled = 0.05;
 constexpr int kMaxExcessRounds = 4;
 
 /// The camera's measured excess noise added to the rests and to the camera links, and the window
-/// solved again until both settle (JointSettings::camera_excess_level).
+/// solved again until both settle (JointSettings::camera_excess_level). `problem` is the window
+/// with the magnetometer fields the screening kept (screenMagnetometer's as_used): the screening
+/// is not repeated, and its notes and left-out fields carry over to each solve.
 JointResult withCameraNoiseAsMeasured(JointProblem* problem, JointResult chosen,
-                                      const Eigen::Matrix3d& R_cam_imu_initial,
                                       const JointSettings& settings) {
   if (!(settings.camera_excess_level > 0.0) || !settings.compute_covariance) return chosen;
+  std::vector<std::string> magnetometer_notes;
+  for (const std::string& note : chosen.notes) {
+    if (note.rfind("magnetometer", 0) == 0) magnetometer_notes.push_back(note);
+  }
   double excess = 0.0, link_excess = 0.0;
   for (int round = 0; round < kMaxExcessRounds && chosen.ok; ++round) {
     double more = joint::cameraExcessVariance(*problem, chosen, settings);
@@ -530,8 +538,11 @@ JointResult withCameraNoiseAsMeasured(JointProblem* problem, JointResult chosen,
     JointProblem inflated = *problem;
     addCameraExcessVariance(more, &inflated);
     addCameraLinkExcessVariance(more_links, &inflated);
-    JointResult again = screenMagnetometer(inflated, R_cam_imu_initial, settings);
+    // From the estimate so far: the added variance moves it little.
+    JointResult again = solveMatrices(inflated, chosen.R_cam_imu, settings);
     if (!again.ok) break;  // the last usable estimate stands
+    again.notes.insert(again.notes.end(), magnetometer_notes.begin(), magnetometer_notes.end());
+    again.mag_poses_left_out = chosen.mag_poses_left_out;
     *problem = std::move(inflated);
     excess += more;
     link_excess += more_links;
@@ -621,11 +632,12 @@ JointResult JointEstimator::solve(const JointProblem& problem,
     return refused;
   }
   joint::ExpandedProblem expanded = joint::expandMotion(problem, settings_);
-  JointResult first = screenMagnetometer(expanded.problem, R_cam_imu_initial, settings_);
+  JointProblem as_used;
+  JointResult first = screenMagnetometer(expanded.problem, R_cam_imu_initial, settings_, &as_used);
   // Solved again (the camera's excess noise below), the window starts from the noise learned.
-  if (first.ok) expanded.problem.noise = first.noise.variance_factor;
-  JointResult chosen =
-      withCameraNoiseAsMeasured(&expanded.problem, std::move(first), R_cam_imu_initial, settings_);
+  if (first.ok) as_used.noise = first.noise.variance_factor;
+  JointResult chosen = withCameraNoiseAsMeasured(&as_used, std::move(first), settings_);
+  if (chosen.ok) expanded.problem = std::move(as_used);
   if (chosen.ok) describeLearnedNoise(expanded.problem, settings_, &chosen);
   joint::mapResultToCaller(expanded, &chosen);
   chosen.solve_time_s =
