@@ -14,8 +14,8 @@
 //
 // Usage: bench_scene_moving [room_robot|room_handheld] [seeds] [first seed] [camera rate, Hz]
 // [default|fast|halved|fullrefined] (default room_robot 20 100 3 default; the features' profiles
-// at profileSettings). Prints one line per seed and the table of BENCHMARKS.md ("Calibration
-// without a board").
+// at profileSettings). Prints one line per seed and the table of BENCHMARKS.md ("Moving
+// objects").
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
