@@ -9,8 +9,7 @@
 // Counters: rms_deg, the RMS geodesic error over the seeds; sigma_deg, the mean of the reported
 // per-axis 1-sigma's norm (the error's expected RMS when the 1-sigma is honest); solved, runs with
 // a joint estimate. The time is that of the whole Monte Carlo (simulation included): not a target.
-// Arguments: poses per recording. Results in BENCHMARKS.md ("Why the noisy grade needs many
-// poses").
+// Arguments: poses per recording. Results in BENCHMARKS.md ("What limits the noisy grade").
 #include <benchmark/benchmark.h>
 
 #include <cmath>

@@ -1,4 +1,4 @@
-// Recordings without rests (issue 25): the cost of continuous-motion calibration on one core.
+// Recordings without rests: the cost of continuous-motion calibration on one core.
 //   BM_MotionWindowSolve: solveWindow on the final window of a 60 s waving recording with 1201
 //     camera frames (20 Hz, all kept: motion_frame_interval_s 0.05): the coarse time offset, the
 //     motion pairs and pair solvers, and the joint estimate with its motion nodes and time offset.

@@ -1,4 +1,4 @@
-// The online calibrator's two costs with a full window (issue: never block the callbacks):
+// The online calibrator's two costs with a full window (the callbacks must never block):
 //   BM_SampleCallbacks: every sample call (addImu, addMagnetic, addFrame) of a 40-pose recording
 //     fed to a threaded OnlineCalibrator with window_poses 30, i.e. what a subscriber callback
 //     spends in the core. Counters: mean_us per call, max_us the slowest call (a pose completing:

@@ -1,4 +1,4 @@
-// Cost of the natural-scene camera rotation (vision/scene_rotation.h, issue 26) on one core
+// Cost of the natural-scene camera rotation (vision/scene_rotation.h) on one core
 // (cv::setNumThreads(1)): SIFT extraction per 640x480 view (features and bearings), and per pair
 // the matching and the rotation (both models, GRIC). The views are test/scene_texture.h's
 // corner-rich texture under a 6.3 deg pure rotation (as test_scene_rotation renders them), f = 500
