@@ -19,6 +19,7 @@
 #include "../test/pipeline_simulation.h"
 #include "camera_imu_alignment/estimation/mount_change.h"
 #include "camera_imu_alignment/online/online_calibrator.h"
+#include "camera_imu_alignment/solve/window_solver.h"
 
 namespace cia = camera_imu_alignment;
 namespace sim = camera_imu_alignment::simulation;

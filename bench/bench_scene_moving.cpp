@@ -28,6 +28,7 @@
 
 #include "../test/pipeline_simulation.h"
 #include "camera_imu_alignment/simulation/imu_grades.h"
+#include "camera_imu_alignment/solve/window_solver.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/vision/scene_rotation.h"
 
@@ -140,10 +141,12 @@ Session solve(std::unique_ptr<sim::SimulationRun> run, const cia::PipelineSettin
       s.inliers += link.inliers;
     }
   }
+  // The links as measured (before the solve's consensus and refit), and the solve.
   const cia::WindowSnapshot window = p.pipeline->snapshot();
-  const cia::AlignmentResult result = cia::solveWindow(window, p.pipeline->settings());
+  const cia::WindowSolveOutput solved = cia::WindowSolver(p.pipeline->settings()).solve(window);
+  const cia::AlignmentResult& result = solved.result;
   s.refitted = result.joint ? static_cast<int>(result.joint->camera_links_refitted.size()) : 0;
-  s.consensus_scale_deg = window.link_consensus.residual_scale_deg;
+  s.consensus_scale_deg = solved.window.link_consensus.residual_scale_deg;
   const auto trueCamera = [&](int local) {
     const int index = window.pose_indices[static_cast<size_t>(local)];
     for (const cia::StationaryPose& pose : p.pipeline->poses()) {
@@ -165,7 +168,7 @@ Session solve(std::unique_ptr<sim::SimulationRun> run, const cia::PipelineSettin
   }
   // CIA_BENCH_LINKS=1: each window link against the truth, as measured and fitted again with the
   // rotation held near the estimate's (a diagnosis, not part of the table).
-  if (std::getenv("CIA_BENCH_LINKS") && result.joint && window.scene_link_refit &&
+  if (std::getenv("CIA_BENCH_LINKS") && result.joint && window.scene_links &&
       result.joint->camera_orientation_fit.size() == window.joint.poses.size()) {
     const auto describe = [&](const char* what, const cia::CameraLink& link,
                               const Eigen::Matrix3d& R, const Eigen::Matrix3d& cov) {
@@ -195,7 +198,7 @@ Session solve(std::unique_ptr<sim::SimulationRun> run, const cia::PipelineSettin
           j < result.joint->camera_link_chi2.size() ? result.joint->camera_link_chi2[j] : -1.0);
       describe("measured", link, link.R_from_to, link.cov_rad2);
       const std::optional<cia::SceneRotation> again =
-          window.scene_link_refit(static_cast<int>(j), R_fit);
+          window.scene_links->refit(static_cast<int>(j), R_fit);
       if (again && again->ok) {
         describe("held", link, again->R_from_to, again->cov_rad2 + link.undecided_rad2);
         std::printf(" %s, %d of %d inliers, %d second motion",
@@ -205,7 +208,7 @@ Session solve(std::unique_ptr<sim::SimulationRun> run, const cia::PipelineSettin
       const Eigen::Matrix3d R_true =
           trueCamera(link.from_pose).transpose() * trueCamera(link.to_pose);
       const std::optional<cia::SceneRotation> at_truth =
-          window.scene_link_refit(static_cast<int>(j), R_true);
+          window.scene_links->refit(static_cast<int>(j), R_true);
       if (at_truth && at_truth->ok) {
         describe("| near the truth", link, at_truth->R_from_to, at_truth->cov_rad2);
         std::printf(" %d second motion", at_truth->second_motion_inliers);

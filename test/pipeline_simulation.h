@@ -18,6 +18,7 @@
 #include "camera_imu_alignment/simulation/scene_renderer.h"
 #include "camera_imu_alignment/simulation/simulation_run.h"
 #include "camera_imu_alignment/simulation/target.h"
+#include "camera_imu_alignment/solve/window_solver.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/vision/target_description.h"
 

@@ -19,6 +19,7 @@
 #include "camera_imu_alignment/estimation/joint_estimator.h"
 #include "camera_imu_alignment/estimation/time_offset.h"
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/solve/window_solver.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/vision/target_description.h"
 #include "test_helpers.h"

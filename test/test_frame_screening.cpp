@@ -22,6 +22,7 @@
 #include "camera_imu_alignment/simulation/renderer.h"
 #include "camera_imu_alignment/simulation/simulation_run.h"
 #include "camera_imu_alignment/simulation/target.h"
+#include "camera_imu_alignment/solve/window_solver.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/vision/camera_pose.h"
 #include "camera_imu_alignment/vision/target_description.h"

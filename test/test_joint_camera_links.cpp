@@ -18,6 +18,7 @@
 #include "camera_imu_alignment/estimation/joint_estimator.h"
 #include "camera_imu_alignment/io/joint_yaml.h"
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/solve/window_solver.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "joint_problem_simulation.h"
 #include "joint_test_helpers.h"
@@ -381,7 +382,8 @@ TEST(JointCameraLinks, TheLinksExcessNoiseIsMeasured) {
 }
 
 // The solve fits every natural-scene link again from its views with the rotation held near the
-// joint estimate's (solveWindow, WindowSnapshot::scene_link_refit), then solves again with them.
+// joint estimate's (the window solve's scene refit stage, WindowSnapshot::scene_links), then
+// solves again with them.
 // Here a third of the links are a moved object's compromise (0.3-0.6 deg off, their 1-sigma grown
 // to 0.1 deg by the free fit's residuals), and the refit stands in for the views: held
 // within 0.3 deg of the truth it finds the truth with 0.05 deg of noise; a clean link's refit
@@ -425,23 +427,36 @@ TEST(JointCameraLinks, LinksAreFittedAgainWithTheRotationHeldNearTheEstimate) {
     }
     const PipelineSettings settings;
     const AlignmentResult without = solveWindow(window, settings);
-    int asked = 0;
-    window.scene_link_refit = [&](int j, const Eigen::Matrix3d& R_near) {
-      ++asked;
-      std::optional<SceneRotation> out;
-      if (rad2deg(geodesicDistance(R_near, truth[j])) > 0.3) return out;
-      out.emplace();
-      out->ok = true;
-      out->R_from_to = refit_of[j];
-      out->cov_rad2 = std::pow(deg2rad(0.05), 2) * Eigen::Matrix3d::Identity();
-      // A compromise's refit finds the moved object as a second motion.
-      out->second_motion_inliers = compromised[j] ? 40 : 0;
-      return out;
+    // The held fits: the true refit of each link when asked near its truth.
+    struct TruthRefitter : SceneLinkRefitter {
+      const std::vector<Eigen::Matrix3d>* truth = nullptr;
+      const std::vector<Eigen::Matrix3d>* refit_of = nullptr;
+      const std::vector<bool>* compromised = nullptr;
+      mutable int asked = 0;
+      SceneLinkKey key(int j) const override { return {j, j + 1}; }
+      std::optional<SceneRotation> refit(int j, const Eigen::Matrix3d& R_near) const override {
+        ++asked;
+        std::optional<SceneRotation> out;
+        const auto k = static_cast<std::size_t>(j);
+        if (rad2deg(geodesicDistance(R_near, (*truth)[k])) > 0.3) return out;
+        out.emplace();
+        out->ok = true;
+        out->R_from_to = (*refit_of)[k];
+        out->cov_rad2 = std::pow(deg2rad(0.05), 2) * Eigen::Matrix3d::Identity();
+        // A compromise's refit finds the moved object as a second motion.
+        out->second_motion_inliers = (*compromised)[k] ? 40 : 0;
+        return out;
+      }
     };
+    auto refitter = std::make_shared<TruthRefitter>();
+    refitter->truth = &truth;
+    refitter->refit_of = &refit_of;
+    refitter->compromised = &compromised;
+    window.scene_links = refitter;
     MountTestBasis basis;
     const AlignmentResult with = solveWindow(window, settings, &basis);
     ASSERT_TRUE(with.joint && with.joint->ok && without.joint && without.joint->ok) << with.message;
-    EXPECT_EQ(asked, static_cast<int>(truth.size()));
+    EXPECT_EQ(refitter->asked, static_cast<int>(truth.size()));
     const std::vector<int>& refitted = with.joint->camera_links_refitted;
     for (std::size_t j = 0; j < truth.size(); ++j) {
       const bool taken = std::find(refitted.begin(), refitted.end(), j) != refitted.end();

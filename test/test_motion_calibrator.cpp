@@ -8,6 +8,7 @@
 
 #include "camera_imu_alignment/config/online_config.h"
 #include "camera_imu_alignment/online/online_calibrator.h"
+#include "camera_imu_alignment/solve/window_solver.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "motion_problem_simulation.h"
 #include "pipeline_simulation.h"

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/solve/window_solver.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "visp_data.h"
 #include "visp_recording.h"

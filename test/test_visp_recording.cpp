@@ -26,6 +26,7 @@
 #include "camera_imu_alignment/estimation/mount_change.h"
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
 #include "camera_imu_alignment/simulation/trajectory.h"
+#include "camera_imu_alignment/solve/window_solver.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 
 #include "visp_data.h"

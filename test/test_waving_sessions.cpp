@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "camera_imu_alignment/online/online_calibrator.h"
+#include "camera_imu_alignment/solve/window_solver.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "pipeline_simulation.h"
 #include "test_helpers.h"

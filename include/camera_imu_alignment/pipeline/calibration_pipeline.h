@@ -1,6 +1,7 @@
 // The offline and online calibration pipeline: time-stamped IMU, magnetometer and camera
-// observations in, stationary poses and their window out (solveWindow gives R_cam_imu). The
-// online calibrator drives this class (for calibrate_bag and the nodelet); it holds no ROS type.
+// observations in, stationary poses and their window out (solve/window_solver.h gives R_cam_imu).
+// The online calibrator drives this class (for calibrate_bag and the nodelet); it holds no ROS
+// type.
 //
 // Data path:
 //   IMU samples -> validation -> StationaryDetector -> segments (gyro bias, mean accel)
@@ -9,8 +10,8 @@
 //     only on frames at rest (never while moving), at most max_frames_per_pose per pose
 //   segment end -> StationaryPose (camera: robust average of the frame orientations; IMU: see
 //     below) -> StationaryWindow -> on_pose. The pipeline does not solve: its owner
-//     (OnlineCalibrator) takes a snapshot() of the window and solves it with solveWindow, e.g. on a
-//     worker thread.
+//     (OnlineCalibrator) takes a snapshot() of the window and solves it with the WindowSolver
+//     (solve/window_solver.h), e.g. on a worker thread.
 //
 // R_cam_imu (PipelineSettings::imu_orientation):
 //   kJoint (default): one maximum-likelihood estimate over the window's poses from every sensor
@@ -64,6 +65,7 @@
 #include "camera_imu_alignment/inertial/stationary_detector.h"
 #include "camera_imu_alignment/pipeline/input_rejections.h"
 #include "camera_imu_alignment/pipeline/sample_sink.h"
+#include "camera_imu_alignment/pipeline/scene_link_refitter.h"
 #include "camera_imu_alignment/solver/alignment_solver.h"
 #include "camera_imu_alignment/solver/pose_window.h"
 #include "camera_imu_alignment/vision/camera_model.h"
@@ -194,41 +196,20 @@ struct RejectedPose {
 /// pipeline at all: the caller, who knows its topics, may say which one is silent.
 inline constexpr char kNoCameraDataReason[] = "no camera data";
 
-/// A copy of the window, to be solved away from the pipeline (solveWindow), e.g. on a worker
+/// A copy of the window, to be solved away from the pipeline (WindowSolver), e.g. on a worker
 /// thread while samples keep arriving.
 struct WindowSnapshot {
   RotationPairs pairs;  ///< StationaryWindow::pairs
   JointProblem joint;   ///< the joint estimator's problem (imu_orientation: joint or magnetometer)
   std::vector<int> pose_indices;  ///< StationaryPose::index of each window pose, oldest first
   /// The natural-scene links' solutions as the gyro's consensus chose them
-  /// (estimation/camera_link_consensus.h; joint.camera_links hold the chosen ones).
+  /// (estimation/camera_link_consensus.h; joint.camera_links hold the chosen ones): filled by the
+  /// solve's consensus stage (solve/window_solver.h), empty in a fresh snapshot.
   CameraLinkConsensus link_consensus;
-  /// Natural scene: fits camera link `link` (index into joint.camera_links) again from its two
-  /// views with the rotation held near `R_from_to_near` while the inliers are chosen
-  /// (estimateSceneRotationNear); nullopt when its views are no longer held. Empty without a
-  /// natural scene. Thread-safe (shares the views' features, read-only, and a locked cache).
-  std::function<std::optional<SceneRotation>(int link, const Eigen::Matrix3d& R_from_to_near)>
-      scene_link_refit;
+  /// Natural scene: the links fitted again from their views near a prediction (the solve's scene
+  /// refit stage); null without a natural scene. Shared, read-only.
+  std::shared_ptr<const SceneLinkRefitter> scene_links;
 };
-
-/// What the mount-change test compares its models on (solveWindow's optional output): the
-/// one-mount estimate of window.joint with the natural-scene links as measured, and, when the solve
-/// fitted links again (JointResult::camera_links_refitted), the problem with them as the estimate
-/// used them and that estimate, its links' excess noise the larger of the two solves'. A change
-/// is declared only when both show it (online/solve_worker.cpp): on the links as measured a
-/// moved object's compromise rotations made the test see a 1 deg remount (simulated hand-held
-/// room, seed 104), on the refitted ones a 0.19 deg misfit (seed 100, no moved object).
-struct MountTestBasis {
-  JointResult as_measured;
-  JointProblem refitted_problem;  ///< empty camera_links when no link was fitted again
-  JointResult refitted;
-};
-
-/// The solve of a window: the pair estimators, then (imu_orientation: joint or
-/// magnetometer) the joint estimate started from the pair estimate. Pure: no pipeline state.
-/// `mount_test` (optional): as MountTestBasis says.
-AlignmentResult solveWindow(const WindowSnapshot& window, const PipelineSettings& settings,
-                            MountTestBasis* mount_test = nullptr);
 
 struct PipelineCallbacks {
   std::function<void(const StationaryPose&)> on_pose;
@@ -268,8 +249,11 @@ class CalibrationPipeline : public SampleSink {
   ImuOrientationSource imuOrientationSource() const override;
   /// End of data: closes the rest in progress and processes the queued frames.
   void finish();
-  /// A copy of the window for solveWindow.
+  /// A copy of the window for the WindowSolver.
   WindowSnapshot snapshot() const;
+  /// The held fits a solve of an earlier snapshot made (WindowSolveOutput::scene_refits): the next
+  /// snapshots' refitters reuse a fit whose prediction nearly matches.
+  void rememberSceneRefits(const std::vector<SceneRefit>& refits);
   /// Forgets all data (poses, window, buffers; counts kept unless clear_counts); the camera
   /// intrinsics stay. Not from a callback.
   void reset(bool clear_counts = false);

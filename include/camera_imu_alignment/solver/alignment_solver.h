@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "camera_imu_alignment/results/joint_result.h"
 #include "camera_imu_alignment/solver/optimal_solver.h"
@@ -56,6 +57,9 @@ struct AlignmentResult {
   /// The joint estimate (pipeline with imu_orientation: joint): when present and ok, R_cam_imu and
   /// quality.std_dev_deg are its, the rest of `quality` is the pair solve's.
   std::optional<JointResult> joint;
+  /// The window solve's stages that had something to say, "stage: note", in the order they ran
+  /// (solve/window_solver.h); empty for a bare pair solve.
+  std::vector<std::string> stage_notes;
 };
 
 /// Solves A_j X = X B_j for X = R_cam_imu.

@@ -240,6 +240,7 @@ void OnlineCalibrator::Impl::applyFinished() {
 }
 
 void OnlineCalibrator::Impl::apply(SolveOutput output) {
+  pipeline->rememberSceneRefits(output.scene_refits);
   if (output.inputs.generation != generation) return;  // the window lost poses since: stale
   if (output.result.status == SolveStatus::kBadInput) return;
   if (output.mount_test && output.mount_test->tested && !output.window.pose_indices.empty()) {
@@ -443,6 +444,7 @@ CalibrateOutcome OnlineCalibrator::calibrateNow(bool force) {
     job.inputs = impl_->inputMark();
     job.window = impl_->pipeline->snapshot();
     output = runSolveJob(std::move(job), impl_->pipeline_settings, impl_->settings);
+    impl_->pipeline->rememberSceneRefits(output.scene_refits);
   }
   const std::size_t poses = output.window.pose_indices.size();
   CalibrateOutcome out;

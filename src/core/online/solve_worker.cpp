@@ -8,35 +8,16 @@ namespace camera_imu_alignment {
 
 SolveOutput runSolveJob(SolveJob job, const PipelineSettings& pipeline,
                         const OnlineSettings& online) {
+  WindowSolveRequest request;
+  request.test_mount_change = job.test_mount_change;
+  request.remount = online.remount;
+  request.poses_not_yet_tested = job.poses_not_yet_tested;
+  WindowSolveOutput solved = WindowSolver(pipeline).solve(job.window, request);
   SolveOutput out;
   out.inputs = job.inputs;
-  MountTestBasis basis;
-  out.result = solveWindow(job.window, pipeline, &basis);
-  if (job.test_mount_change && out.result.joint && out.result.joint->ok && basis.as_measured.ok) {
-    // A split whose first pose was never a candidate of a test (its windows were skipped) is
-    // one: the splits with fewer than min_poses_after poses after them in the last tested window
-    // were only pending, so the reach is the untested poses plus min_poses_after - 1.
-    MountChangeSettings remount = online.remount;
-    remount.max_poses_after =
-        std::max(remount.max_poses_after, job.poses_not_yet_tested + remount.min_poses_after - 1);
-    const JointSettings joint = jointSettingsOf(pipeline);
-    MountChangeTest test = testMountChange(job.window.joint, basis.as_measured, joint, remount);
-    // With natural-scene links fitted again, a change must show on them too (MountTestBasis).
-    if ((test.detected || test.pending) && !basis.refitted_problem.camera_links.empty() &&
-        basis.refitted.ok) {
-      const MountChangeTest again =
-          testMountChange(basis.refitted_problem, basis.refitted, joint, remount);
-      if (!again.detected && !again.pending) {
-        test.detected = test.pending = false;
-        test.message = "no mount change: the natural-scene rotations as measured show one (" +
-                       test.message +
-                       "), but not once fitted again with the rotation held near the estimate "
-                       "(a moved object in view; " +
-                       again.message + ")";
-      }
-    }
-    out.mount_test = std::move(test);
-  }
+  out.result = std::move(solved.result);
+  out.mount_test = std::move(solved.mount_test);
+  out.scene_refits = std::move(solved.scene_refits);
   out.window = std::move(job.window);
   return out;
 }

@@ -12,6 +12,7 @@
 
 #include "camera_imu_alignment/online/online_types.h"
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
+#include "camera_imu_alignment/solve/window_solver.h"
 
 namespace camera_imu_alignment {
 
@@ -41,9 +42,10 @@ struct SolveOutput {
   WindowSnapshot window;  ///< the job's (pose indices of the estimate)
   AlignmentResult result;
   std::optional<MountChangeTest> mount_test;
+  std::vector<SceneRefit> scene_refits;  ///< for CalibrationPipeline::rememberSceneRefits
 };
 
-/// The solve and, for joint estimates, the change-point test.
+/// The window solve (solve/window_solver.h) with, for joint estimates, the change-point test.
 SolveOutput runSolveJob(SolveJob job, const PipelineSettings& pipeline,
                         const OnlineSettings& online);
 

@@ -6,7 +6,6 @@
 #include <limits>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -48,14 +47,6 @@ struct SegmentField {
   Eigen::Matrix3d mean_cov_t2 = Eigen::Matrix3d::Zero();  ///< covariance of the mean (scatter / N)
   double scatter_deg = 0.0;
 };
-
-/// Before a solve with motion frames (motion_assembly.cpp): the time offset's coarse value and the
-/// gyro's noise into the joint problem, and pairs of motion nodes when the window has no rest
-/// pairs (for the pair solvers and the joint estimate's start). The motion frames are dropped
-/// when the offset cannot be found; returns what was done or why not, for the result's message.
-/// `figures` gets the coarse offset's curve and the motion's excitation (JointResult::motion).
-std::string prepareMotion(const PipelineSettings& settings, WindowSnapshot* window,
-                          MotionFigures* figures);
 
 struct CalibrationPipeline::Impl {
   Impl(const TargetDescription& target, const PipelineSettings& settings,
@@ -142,17 +133,10 @@ struct CalibrationPipeline::Impl {
     std::shared_ptr<const SceneFeatures> features;  ///< shared with the snapshots' refits
   };
   std::deque<SceneView> scene_views;
-  /// Links fitted again with the rotation held (WindowSnapshot::scene_link_refit), by their poses'
-  /// StationaryPose::index: a later solve with nearly the same prediction reuses the fit.
-  struct SceneRefitCache {
-    struct Entry {
-      Eigen::Matrix3d R_from_to_near = Eigen::Matrix3d::Identity();
-      SceneRotation rotation;
-    };
-    std::mutex mutex;
-    std::map<std::pair<int, int>, Entry> entries;
-  };
-  std::shared_ptr<SceneRefitCache> scene_refit_cache = std::make_shared<SceneRefitCache>();
+  /// Links fitted again with the rotation held (WindowSnapshot::scene_links), by their poses'
+  /// StationaryPose::index, as solves returned them (rememberSceneRefits): a later solve with
+  /// nearly the same prediction reuses the fit.
+  SceneRefitMemory scene_refits;
   /// The matches of each link (by its poses' StationaryPose::index), for fitting it again.
   std::map<std::pair<int, int>, std::shared_ptr<const SceneMatches>> scene_link_matches;
   int scenes_started = 0;
@@ -197,9 +181,9 @@ struct CalibrationPipeline::Impl {
   /// joint_gyro_pending by the gyro samples since the previous rest.
   StationaryWindow::Entry jointMeasurements(const StationarySegment& segment,
                                             const StationaryPose& pose, const SegmentField& field);
-  /// Natural scene: WindowSnapshot::scene_link_refit for `problem`'s links (pose indices local to
-  /// the window, `pose_indices` their StationaryPose::index); empty without a natural scene.
-  std::function<std::optional<SceneRotation>(int, const Eigen::Matrix3d&)> sceneLinkRefit(
+  /// Natural scene: WindowSnapshot::scene_links for `problem`'s links (pose indices local to the
+  /// window, `pose_indices` their StationaryPose::index); null without a natural scene.
+  std::shared_ptr<const SceneLinkRefitter> sceneLinkRefitter(
       const JointProblem& problem, const std::vector<int>& pose_indices) const;
   WindowSnapshot snapshot() const;
 };

@@ -23,11 +23,11 @@ constexpr std::size_t kMaxSceneCandidates = 64;
 /// ambiguity on a near-planar view) and is not used.
 constexpr double kAngleCheckFloorDeg = 0.2;
 constexpr double kAngleCheckSigmas = 4.0;
-/// A link fitted again with the rotation held near the estimate's (sceneLinkRefit): the inliers'
+/// A link fitted again with the rotation held near the estimate's (sceneLinkRefitter): the inliers'
 /// gate (pixels). About 3 of the images' noise; the estimate's prediction of a link is good to
 /// about a pixel (0.1 deg at 500 px).
 constexpr double kHeldRotationGatePx = 1.5;
-/// A cached refit serves while the prediction stays within this share of the gate.
+/// A remembered refit serves while the prediction stays within this share of the gate.
 constexpr double kRefitReuseShare = 0.5;
 
 double rmsSigmaDeg(const Eigen::Matrix3d& cov_rad2) {
@@ -177,58 +177,88 @@ std::string CalibrationPipeline::Impl::assessScene(const StationarySegment& segm
   while (!scene_link_matches.empty() && gone(scene_link_matches.begin()->first)) {
     scene_link_matches.erase(scene_link_matches.begin());
   }
-  {
-    const std::lock_guard<std::mutex> lock(scene_refit_cache->mutex);
-    auto& entries = scene_refit_cache->entries;
-    while (!entries.empty() && gone(entries.begin()->first)) entries.erase(entries.begin());
+  while (!scene_refits.empty() && gone(scene_refits.begin()->first)) {
+    scene_refits.erase(scene_refits.begin());
   }
   return "";
 }
 
-std::function<std::optional<SceneRotation>(int, const Eigen::Matrix3d&)>
-CalibrationPipeline::Impl::sceneLinkRefit(const JointProblem& problem,
-                                          const std::vector<int>& pose_indices) const {
-  if (!natural_scene || !intrinsics || problem.camera_links.empty()) return {};
+namespace {
+
+/// The pipeline's refitter: the window's views (features shared read-only), the links' matches,
+/// the intrinsics and a copy of the remembered fits of its links.
+class ViewSceneLinkRefitter : public SceneLinkRefitter {
+ public:
   std::map<int, std::shared_ptr<const SceneFeatures>> views;
-  for (const SceneView& v : scene_views) views[v.pose_index] = v.features;
-  std::vector<std::pair<int, int>> link_poses;  // StationaryPose::index of each link's views
-  std::vector<std::shared_ptr<const SceneMatches>> link_matches;  // null: match again
+  std::vector<SceneLinkKey> link_poses;  ///< StationaryPose::index of each link's views
+  std::vector<std::shared_ptr<const SceneMatches>> link_matches;  ///< null: match again
+  SceneRefitMemory remembered_fits;
+  CameraIntrinsics intrinsics;
+  SceneRotationSettings scene_settings;
+  double reuse_rad = 0.0;
+
+  SceneLinkKey key(int link) const override {
+    return link >= 0 && link < static_cast<int>(link_poses.size())
+               ? link_poses[static_cast<std::size_t>(link)]
+               : SceneLinkKey{-1, -1};
+  }
+  std::optional<SceneRotation> remembered(int link, const Eigen::Matrix3d& R_near) const override {
+    const auto hit = remembered_fits.find(key(link));
+    if (hit == remembered_fits.end() ||
+        !(rotationAngle(hit->second.R_from_to_near.transpose() * R_near) < reuse_rad)) {
+      return std::nullopt;
+    }
+    return hit->second.rotation;
+  }
+  std::optional<SceneRotation> refit(int link, const Eigen::Matrix3d& R_near) const override {
+    const SceneLinkKey k = key(link);
+    const auto from = views.find(k.first), to = views.find(k.second);
+    if (from == views.end() || to == views.end()) return std::nullopt;
+    SceneRotation again = estimateSceneRotationNear(
+        *from->second, *to->second, intrinsics, R_near, kHeldRotationGatePx, scene_settings,
+        link_matches[static_cast<std::size_t>(link)].get());
+    again.matched = SceneMatches();  // the rotation only: it is remembered
+    return again;
+  }
+};
+
+}  // namespace
+
+std::shared_ptr<const SceneLinkRefitter> CalibrationPipeline::Impl::sceneLinkRefitter(
+    const JointProblem& problem, const std::vector<int>& pose_indices) const {
+  if (!natural_scene || !intrinsics || problem.camera_links.empty()) return nullptr;
+  auto refitter = std::make_shared<ViewSceneLinkRefitter>();
+  for (const SceneView& v : scene_views) refitter->views[v.pose_index] = v.features;
   const auto global = [&](int local) {
     return local >= 0 && local < static_cast<int>(pose_indices.size())
                ? pose_indices[static_cast<std::size_t>(local)]
                : -1;
   };
   for (const CameraLink& link : problem.camera_links) {
-    link_poses.emplace_back(global(link.from_pose), global(link.to_pose));
-    const auto matched = scene_link_matches.find(link_poses.back());
-    link_matches.push_back(matched == scene_link_matches.end() ? nullptr : matched->second);
+    const SceneLinkKey key(global(link.from_pose), global(link.to_pose));
+    refitter->link_poses.push_back(key);
+    const auto matched = scene_link_matches.find(key);
+    refitter->link_matches.push_back(matched == scene_link_matches.end() ? nullptr
+                                                                         : matched->second);
+    const auto fit = scene_refits.find(key);
+    if (fit != scene_refits.end()) refitter->remembered_fits.insert(*fit);
   }
   const double focal = std::sqrt(intrinsics->K(0, 0) * intrinsics->K(1, 1));
-  const double reuse_rad = kRefitReuseShare * kHeldRotationGatePx / focal;
-  return [views = std::move(views), link_poses = std::move(link_poses),
-          link_matches = std::move(link_matches), intrinsics = *intrinsics,
-          scene_settings = settings.scene_rotation, cache = scene_refit_cache,
-          reuse_rad](int link, const Eigen::Matrix3d& R_near) -> std::optional<SceneRotation> {
-    if (link < 0 || link >= static_cast<int>(link_poses.size())) return std::nullopt;
-    const std::pair<int, int> key = link_poses[static_cast<std::size_t>(link)];
-    const auto from = views.find(key.first), to = views.find(key.second);
-    if (from == views.end() || to == views.end()) return std::nullopt;
-    {
-      const std::lock_guard<std::mutex> lock(cache->mutex);
-      const auto hit = cache->entries.find(key);
-      if (hit != cache->entries.end() &&
-          rotationAngle(hit->second.R_from_to_near.transpose() * R_near) < reuse_rad) {
-        return hit->second.rotation;
-      }
+  refitter->reuse_rad = kRefitReuseShare * kHeldRotationGatePx / focal;
+  refitter->intrinsics = *intrinsics;
+  refitter->scene_settings = settings.scene_rotation;
+  return refitter;
+}
+
+void CalibrationPipeline::rememberSceneRefits(const std::vector<SceneRefit>& refits) {
+  for (const SceneRefit& fit : refits) {
+    if (fit.key.first < 0 || fit.key.second < 0) continue;
+    // Only links whose views the pipeline still holds (a later solve may ask for them again).
+    if (impl_->scene_views.empty() || fit.key.first < impl_->scene_views.front().pose_index) {
+      continue;
     }
-    SceneRotation again = estimateSceneRotationNear(
-        *from->second, *to->second, intrinsics, R_near, kHeldRotationGatePx, scene_settings,
-        link_matches[static_cast<std::size_t>(link)].get());
-    again.matched = SceneMatches();  // the cache keeps the rotation only
-    const std::lock_guard<std::mutex> lock(cache->mutex);
-    cache->entries[key] = {R_near, again};
-    return again;
-  };
+    impl_->scene_refits[fit.key] = fit;
+  }
 }
 
 }  // namespace camera_imu_alignment
