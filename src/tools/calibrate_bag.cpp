@@ -16,6 +16,7 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -267,11 +268,10 @@ int run(const cia::CliArgs& args) {
   const auto solve_start = std::chrono::steady_clock::now();
   const cia::CalibrateOutcome outcome = calibrator->calibrateNow(false);
   if (!args.has("--quiet")) {
-    std::cerr
-        << "[calibrate_bag] final solve done in " << std::fixed << std::setprecision(1)
-        << std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count()
-        << " s" << std::endl;
-    std::cerr.unsetf(std::ios::floatfield);
+    std::ostringstream took;  // std::cerr's own format stays as it is
+    took << std::fixed << std::setprecision(1)
+         << std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_start).count();
+    std::cerr << "[calibrate_bag] final solve done in " << took.str() << " s" << std::endl;
   }
   const cia::CalibrationSnapshot snap = calibrator->snapshot(cia::SnapshotContents::kWithHistory);
   std::cerr << "[calibrate_bag] read " << snap.inputs.imu_samples << " IMU, "

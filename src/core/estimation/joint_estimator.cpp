@@ -637,8 +637,10 @@ JointResult JointEstimator::solve(const JointProblem& problem,
   // Solved again (the camera's excess noise below), the window starts from the noise learned.
   if (first.ok) as_used.noise = first.noise.variance_factor;
   JointResult chosen = withCameraNoiseAsMeasured(&as_used, std::move(first), settings_);
-  if (chosen.ok) expanded.problem = std::move(as_used);
-  if (chosen.ok) describeLearnedNoise(expanded.problem, settings_, &chosen);
+  if (chosen.ok) {
+    expanded.problem = std::move(as_used);
+    describeLearnedNoise(expanded.problem, settings_, &chosen);
+  }
   joint::mapResultToCaller(expanded, &chosen);
   chosen.solve_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
