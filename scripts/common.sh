@@ -59,10 +59,17 @@ cia_setup_workspace() {
 }
 
 # cia_build [extra catkin_make targets...]
+# A ccache on the machine is used when present (optional: rebuilds and several checkouts of the
+# repository share one cache; CCACHE_BASEDIR makes the workspace's paths relative).
 cia_build() {
   cia_setup_workspace
+  local launcher=()
+  if command -v ccache >/dev/null 2>&1; then
+    export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$(dirname "${REPO_ROOT}")}"
+    launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
+  fi
   (cd "${WS}" && catkin_make -j2 -DCMAKE_BUILD_TYPE=Release -DCATKIN_ENABLE_TESTING=ON \
-      -DPYTHON_EXECUTABLE=/usr/bin/python3 "$@")
+      -DPYTHON_EXECUTABLE=/usr/bin/python3 "${launcher[@]}" "$@")
 }
 
 # devel/setup.bash reads unset variables (ROS_DISTRO): never source it under set -u.
