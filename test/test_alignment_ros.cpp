@@ -281,6 +281,7 @@ TEST_F(AlignmentRos, ReplayBroadcastsTheTruthAndTheServicesWork) {
   Calibrate calibrate;
   ASSERT_TRUE(call("calibrate", &calibrate));
   EXPECT_TRUE(calibrate.response.success) << calibrate.response.message;
+  EXPECT_TRUE(calibrate.response.has_estimate);
   // Whether it is what the tf says, and why not when it is not.
   EXPECT_EQ(calibrate.response.not_broadcast_reason.empty(), calibrate.response.broadcast)
       << calibrate.response.not_broadcast_reason;
@@ -341,6 +342,10 @@ TEST_F(AlignmentRos, ReplayBroadcastsTheTruthAndTheServicesWork) {
   ASSERT_TRUE(call("calibrate", &after_reset));
   EXPECT_FALSE(after_reset.response.success);
   EXPECT_EQ(after_reset.response.poses, 0u);
+  // Nothing solved: no rotation is answered (not an identity that reads as an estimate).
+  EXPECT_FALSE(after_reset.response.has_estimate);
+  const auto& q = after_reset.response.q_cam_imu;
+  EXPECT_EQ(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w, 0.0);
 
   // A restarted node (another name and frames) broadcasts the saved calibration at once.
   const ExtraNode restarted(

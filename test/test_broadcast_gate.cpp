@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <limits>
 
 #include "camera_imu_alignment/online/broadcast_gate.h"
@@ -152,6 +153,32 @@ TEST(BroadcastGate, NoSilentRegressionUnlessMorePosesOrADifferentMount) {
             GateDecision::kBroadcast);
 }
 
+// Recordings without rests have no poses to count: the camera orientations during motion count
+// instead (an estimate from more motion was kept back as "from 0 poses" against "0").
+TEST(BroadcastGate, NoSilentRegressionCountsTheMotionWithoutRests) {
+  OnlineSettings s;
+  s.min_motion_s = 0.0;
+  s.min_motion_rotation_deg = 0.0;
+  const auto motionResult = [](double sigma_deg, double turn_deg, int nodes) {
+    AlignmentResult r = jointResult(sigma_deg, turned(turn_deg), 0.5);
+    r.joint->motion_nodes = nodes;
+    r.joint->motion.excitation_duration_s = 30.0;
+    r.joint->motion.excitation_rad = Eigen::Vector3d::Constant(10.0);
+    return r;
+  };
+  BroadcastEstimate published = broadcastOf(motionResult(0.05, 0.0, 200), 0);
+  published.result = motionResult(0.05, 0.0, 200);
+  const GateOutcome less = judgeEstimate(motionResult(0.06, 0.1, 150), 0, s, published, false);
+  EXPECT_EQ(less.decision, GateDecision::kKeep);
+  EXPECT_NE(less.why.find("from 150 camera orientations during motion is larger than the "
+                          "broadcast estimate's 0.05 deg from 200 camera orientations"),
+            std::string::npos)
+      << less.why;
+  EXPECT_EQ(less.why.find("0 poses"), std::string::npos) << less.why;
+  EXPECT_EQ(judgeEstimate(motionResult(0.06, 0.1, 300), 0, s, published, false).decision,
+            GateDecision::kBroadcast);
+}
+
 TEST(BroadcastGate, DifferenceSignificance) {
   const BroadcastEstimate published = broadcastOf(jointResult(0.05, turned(0.0), 0.5), 10);
   // 0.05 deg apart with 1-sigma 0.05 each: chi2 = 0.05^2 / (2 x 0.05^2) = 0.5 -> p ~ 0.92.
@@ -194,6 +221,49 @@ TEST(BroadcastGate, CheckOfACurrentCalibrationInDegreesAndSigmas) {
   EXPECT_NE(far->text.find("recalibrate"), std::string::npos) << far->text;
   // No joint estimate (pair modes): no check.
   EXPECT_FALSE(checkCalibration(goodResult(0.03), current, 1e-3));
+}
+
+// The warning about a broadcast tf the latest estimate disagrees with (analytic: 1-sigma 0.03 deg
+// on each side, so 1 sigma of the difference is 0.0424 deg): 0.15 deg is 3.54 sigma, consistent at
+// the default consistency_level 0.001 (4.0 sigma) yet warned; 0.12 deg (2.83 sigma) is not; the
+// broadcast estimate itself, or no check, never.
+TEST(BroadcastGate, ABroadcastBeyondThreeSigmaOfTheLatestEstimateIsWarnedAbout) {
+  const BroadcastEstimate current = broadcastOf(jointResult(0.03, turned(0.0), 0.5), 12);
+  const auto far = checkCalibration(jointResult(0.03, turned(0.15), 0.5), current, 1e-3);
+  ASSERT_TRUE(far);
+  EXPECT_TRUE(far->consistent);
+  EXPECT_NEAR(far->sigmas, 0.15 / std::sqrt(2.0 * 0.03 * 0.03), 1e-6);
+  const std::string warning = broadcastWarning(far, false, "min_change_deg 0.5: 0.15 deg");
+  EXPECT_NE(warning.find("0.15 deg (3.5 sigma)"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("min_change_deg 0.5"), std::string::npos) << warning;
+  EXPECT_EQ(broadcastWarning(far, true, "x"), "");  // the tf is the latest estimate
+  const auto near = checkCalibration(jointResult(0.03, turned(0.12), 0.5), current, 1e-3);
+  ASSERT_TRUE(near);
+  EXPECT_LT(near->sigmas, kBroadcastWarningSigmas);
+  EXPECT_EQ(broadcastWarning(near, false, "x"), "");
+  // Inconsistent at a stricter level than 3 sigma: warned too.
+  const auto strict = checkCalibration(jointResult(0.03, turned(0.12), 0.5), current, 0.05);
+  ASSERT_TRUE(strict);
+  EXPECT_FALSE(strict->consistent);
+  EXPECT_NE(broadcastWarning(strict, false, ""), "");
+  EXPECT_EQ(broadcastWarning(std::nullopt, false, "x"), "");
+}
+
+// Which camera axes the motion has not turned about enough (min_motion_rotation_deg), in words.
+TEST(BroadcastGate, TheAxesTheMotionHasNotTurnedAboutAreNamed) {
+  OnlineSettings settings;
+  settings.min_motion_rotation_deg = 180.0;
+  MotionFigures m;
+  m.excitation_rad = Eigen::Vector3d(deg2rad(400), deg2rad(250), deg2rad(30));
+  EXPECT_EQ(unexcitedAxes(m, settings), "camera z");
+  m.excitation_rad = Eigen::Vector3d(deg2rad(10), deg2rad(250), deg2rad(30));
+  EXPECT_EQ(unexcitedAxes(m, settings), "camera x and camera z");
+  m.excitation_rad = Eigen::Vector3d::Zero();
+  EXPECT_EQ(unexcitedAxes(m, settings), "camera x, camera y and camera z");
+  m.excitation_rad = Eigen::Vector3d::Constant(deg2rad(180.0));
+  EXPECT_EQ(unexcitedAxes(m, settings), "");
+  m.excitation_rad(1) = std::nan("");
+  EXPECT_EQ(unexcitedAxes(m, settings), "camera y");
 }
 
 }  // namespace

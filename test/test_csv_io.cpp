@@ -495,6 +495,18 @@ TEST(ResultYaml, ReaderErrorsNameTheFileAndTheProblem) {
   expectError(read,
               writeTemp("refl.yaml", "R_cam_imu:\n  matrix: [[1, 0, 0], [0, 1, 0], [0, 0, -1]]\n"),
               -1, {"matrix"});
+  // A hand edit of one of the two forms (the quaternion turned 90 deg about z, the matrix kept):
+  // refused, naming both keys and the angle.
+  expectError(read,
+              writeTemp("disagree.yaml",
+                        "R_cam_imu:\n  quaternion_xyzw: [0, 0, 0.70710678, 0.70710678]\n"
+                        "  matrix: [[1, 0, 0], [0, 1, 0], [0, 0, 1]]\n"),
+              -1, {"quaternion_xyzw", "matrix", "deg apart"});
+  // Agreeing to the matrix's 4 typed decimals (0.005 deg): read.
+  EXPECT_NO_THROW(readResultYaml(
+      writeTemp("agree.yaml",
+                "R_cam_imu:\n  quaternion_xyzw: [0, 0, 0.70710678, 0.70710678]\n"
+                "  matrix: [[0.0000, -1.0000, 0], [1.0000, 0.0000, 0], [0, 0, 1]]\n")));
 }
 
 }  // namespace

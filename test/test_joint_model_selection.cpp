@@ -71,6 +71,11 @@ TEST(JointModelSelection, ScaleAndMisalignmentErrorsAreDetected) {
       const JointResult select = solveSimulation(sim, withModel(ImuMatrixModel::kSelect));
       ASSERT_TRUE(select.ok) << select.message;
       EXPECT_TRUE(hasNote(select, "T_g and T_a estimated")) << test::allNotes(select);
+      // A tail probability that underflowed reads "< 1e-300", never "p < 0" or "p 0".
+      for (const std::string& note : select.notes) {
+        EXPECT_EQ(note.find("p < 0)"), std::string::npos) << note;
+        EXPECT_FALSE(note.size() >= 4 && note.compare(note.size() - 4, 4, " p 0") == 0) << note;
+      }
       EXPECT_LT(test::maxNormalisedError(select, sim), 3.5) << "seed " << seed;
       // Held at identity regardless, the same unit is flagged by the chi-square test.
       const JointResult identity = solveSimulation(sim, withModel(ImuMatrixModel::kIdentity));

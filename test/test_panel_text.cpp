@@ -148,6 +148,23 @@ TEST(DescribeStatus, ShowsEveryFieldOfACalibratedStatus) {
   expectNoNan(view);
 }
 
+// Waving: how far the camera turned about each of its axes, and the axis still to turn about.
+TEST(DescribeStatus, TheMotionsTurnPerCameraAxisAndTheAxisStillMissing) {
+  AlignmentStatus s = calibratedStatus();
+  EXPECT_EQ(row(describeStatus(s), "motion turned (x, y, z)").value, "-");  // rests only
+  s.motion_nodes = 600;
+  s.excitation_deg = {412.4, 250.0, 31.2};
+  s.excitation_missing = "camera z";
+  const PanelRow missing = row(describeStatus(s), "motion turned (x, y, z)");
+  EXPECT_EQ(missing.value, "[412, 250, 31] deg; turn about camera z");
+  EXPECT_EQ(missing.level, RowLevel::kWarning);
+  s.excitation_deg[2] = 190.0;
+  s.excitation_missing.clear();
+  EXPECT_EQ(row(describeStatus(s), "motion turned (x, y, z)").level, RowLevel::kNormal);
+  s.excitation_deg[0] = std::nan("");
+  EXPECT_EQ(row(describeStatus(s), "motion turned (x, y, z)").level, RowLevel::kError);
+}
+
 TEST(DescribeStatus, StatesTheRpyConventionBeforeTheAngles) {
   const StatusView view = describeStatus(calibratedStatus());
   const std::size_t convention = rowIndex(view, "angles");

@@ -213,6 +213,65 @@ TEST_F(UserInputsRos, SaveFalseWritesAndLoadsNothingTheDriverPresetSetsTopicsDef
             output_param("alignment.launch target:=t.yaml"));
 }
 
+// replay_bag.launch passes the camera and frame args on (roslaunch ignored unknown ones silently:
+// a compressed bag could not be replayed), and alignment.launch keeps the config's keys when they
+// are not given (it set image_transport back to raw over the config's).
+TEST_F(UserInputsRos, ReplayBagTakesTheTransportFramesAndDriverAndEmptyArgsKeepTheConfig) {
+  const auto params = [](const std::string& args) {
+    const test::ToolRun r = test::runTool("roslaunch --dump-params camera_imu_alignment " + args);
+    EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+    return r.out;
+  };
+  const auto value = [](const std::string& dump, const std::string& key) {
+    const std::size_t at = dump.find("/camera_imu_alignment/" + key + ": ");
+    if (at == std::string::npos) return std::string("(none)");
+    const std::size_t from = dump.find(": ", at) + 2;
+    return dump.substr(from, dump.find('\n', from) - from);
+  };
+  const std::string given = params(
+      "replay_bag.launch bag:=b.bag image_transport:=compressed camera_frame:=cam "
+      "imu_frame:=body publish_inverse:=true");
+  EXPECT_EQ(value(given, "image_transport"), "compressed") << given;
+  EXPECT_EQ(value(given, "camera_frame"), "cam") << given;
+  EXPECT_EQ(value(given, "imu_frame"), "body") << given;
+  EXPECT_EQ(value(given, "publish_inverse"), "true") << given;
+  // Not given: the config's values (default.yaml: raw, '', '', false).
+  const std::string config = test::tempPath("compressed_config.yaml");
+  {
+    std::string text = test::readFile(DEFAULT_CONFIG_YAML);
+    const std::size_t at = text.find("\nimage_transport: raw");
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, std::string("\nimage_transport: raw").size(), "\nimage_transport: compressed");
+    std::ofstream(config) << text;
+  }
+  const std::string kept = params("replay_bag.launch bag:=b.bag config:=" + config);
+  EXPECT_EQ(value(kept, "image_transport"), "compressed") << kept;
+  EXPECT_EQ(value(kept, "publish_inverse"), "false") << kept;
+}
+
+// A nodelet that cannot start (a misspelt config key) stops its launch: the loader is required
+// (it left a manager running that did nothing), as the node's exit 2 stops it.
+TEST_F(UserInputsRos, ANodeletThatCannotStartStopsItsLaunch) {
+  const std::string config = test::tempPath("misspelt_config.yaml");
+  std::ofstream(config) << test::readFile(DEFAULT_CONFIG_YAML) << "\nmin_change_dge: 0.1\n";
+  const auto start = std::chrono::steady_clock::now();
+  // timeout's exit 124 would mean the launch kept running.
+  const test::ToolRun r = test::runTool(
+      "roslaunch camera_imu_alignment alignment.launch name:=misspelt manager:=misspelt_manager "
+      "save:=false config:=" +
+          config,
+      90);
+  const double took_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_NE(r.exit_code, 124) << "the launch kept running after the failed load:\n"
+                              << r.out << r.err;
+  const std::string said = r.out + r.err;
+  EXPECT_NE(said.find("min_change_dge"), std::string::npos) << said;
+  EXPECT_NE(said.find("did you mean"), std::string::npos) << said;
+  EXPECT_NE(said.find("REQUIRED process"), std::string::npos) << said;  // roslaunch names it
+  std::cout << "[user_inputs] the misspelt launch stopped after " << took_s << " s\n";
+}
+
 TEST_F(UserInputsRos, TheMissingCameraTopicIsTheOneNamed) {
   // One instance gets images without their camera info, another the camera info while its image
   // topic is wrong; both get a still IMU, so that a rest ends when it stops.

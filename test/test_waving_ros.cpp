@@ -169,6 +169,10 @@ TEST(WavingNodelet, BroadcastsWithinTwoTenthsOfADegreeWithinSixtySecondsOfMotion
   EXPECT_GE(status->motion_nodes, 500u);
   EXPECT_EQ(status->poses_total, 0u);  // no rests: the motion alone
   EXPECT_TRUE(status->has_broadcast);
+  // 60 s of waving about every axis: the status says how far the camera turned about each, and
+  // no axis is still missing (min_motion_rotation_deg 180 in default.yaml).
+  for (int i = 0; i < 3; ++i) EXPECT_GE(status->excitation_deg[i], 180.0) << "axis " << i;
+  EXPECT_EQ(status->excitation_missing, "") << status->message;
   std::cout << "[waving_nodelet] timeshift " << 1e3 * status->timeshift_cam_imu_s << " +- "
             << 1e3 * status->timeshift_sigma_s << " ms, " << status->motion_nodes
             << " motion nodes, wall "

@@ -54,29 +54,33 @@ std::string AlignmentWrapper::Impl::imuFrame() const {
 
 void AlignmentWrapper::Impl::onBroadcast(const BroadcastEstimate& estimate) {
   noteReplacedBroadcast(estimate);
-  // A refined estimate (within min_change_deg) keeps the tf: only the file changes.
+  // A refined estimate (within min_change_deg) keeps the tf: only its 1-sigma and the file change.
   const bool refined = sent_R_cam_imu && sent_R_cam_imu->isApprox(estimate.R_cam_imu, 1e-12);
-  if (refined) {
-    ROS_INFO(
-        "%s: the tf stays; the saved calibration becomes the %d-pose estimate (1-sigma %.4f "
-        "deg)",
-        name.c_str(), estimate.poses, estimate.maxStdDevDeg());
-  } else {
+  if (!refined) {
     sendTransform(estimate.R_cam_imu);
     sent_R_cam_imu = estimate.R_cam_imu;
   }
-  if (estimate.source != "estimated" || settings.output_file.empty()) {
+  if (estimate.source != "estimated") {  // a loaded calibration: no solve reports it
     publishStatus();
     return;
   }
+  // An estimate's status goes out once, from onEstimate, which follows.
   std::string error;
-  if (save(estimate, &error)) {
+  const bool saved = !settings.output_file.empty() && save(estimate, &error);
+  if (saved || settings.output_file.empty()) {
     save_error.clear();
   } else {
     save_error = error;
     ROS_ERROR_THROTTLE(10.0, "%s: %s", name.c_str(), error.c_str());
   }
-  publishStatus();
+  if (refined) {
+    ROS_INFO("%s: the tf stays; %s the %d-pose estimate (1-sigma %.4f deg)", name.c_str(),
+             saved                          ? "the saved calibration becomes"
+             : settings.output_file.empty() ? "its 1-sigma becomes that of"
+                                            : "not saved (see the error above): its 1-sigma "
+                                              "becomes that of",
+             estimate.poses, estimate.maxStdDevDeg());
+  }
 }
 
 void AlignmentWrapper::Impl::sendTransform(const Eigen::Matrix3d& R_cam_imu) {
@@ -141,8 +145,13 @@ void AlignmentWrapper::Impl::publishStatus() {
     if (snap.inputs.imu_samples == 0) {
       s.message = "waiting for IMU data on " + imu_sub.getTopic();
     } else {
-      s.message = "waiting for the camera: nothing on " + topicOf(InputStream::kImage) + " / " +
-                  topicOf(InputStream::kCameraInfo) + " / " + camera_pose_sub.getTopic() + " yet";
+      // Images without their camera info are not "nothing on the image topic".
+      const std::string hint = cameraInputHint();
+      s.message = "waiting for the camera: " +
+                  (hint.empty() ? "nothing on " + topicOf(InputStream::kImage) + " / " +
+                                      topicOf(InputStream::kCameraInfo) + " / " +
+                                      camera_pose_sub.getTopic() + " yet"
+                                : hint);
     }
   }
   s.poses_in_window = static_cast<std::uint32_t>(snap.window.size());
@@ -171,6 +180,11 @@ void AlignmentWrapper::Impl::publishStatus() {
       s.timeshift_estimated = r.joint->timeshift_estimated;
       s.timeshift_cam_imu_s = r.joint->timeshift_cam_imu_s;
       s.timeshift_sigma_s = r.joint->timeshift_sigma_s;
+      if (r.joint->motion_nodes > 0) {
+        for (int i = 0; i < 3; ++i)
+          s.excitation_deg[i] = rad2deg(r.joint->motion.excitation_rad(i));
+        s.excitation_missing = unexcitedAxes(r.joint->motion, settings.online);
+      }
     }
   }
   s.poses_needed = snap.progress.poses_needed;
@@ -281,7 +295,8 @@ bool AlignmentWrapper::Impl::onCalibrate(Calibrate::Request& req, Calibrate::Res
   res.broadcast = outcome.broadcast;
   res.not_broadcast_reason = outcome.not_broadcast_reason;
   res.message = r.message;
-  if (r.status != SolveStatus::kBadInput) {
+  res.has_estimate = r.status != SolveStatus::kBadInput && r.R_cam_imu.allFinite();
+  if (res.has_estimate) {
     res.q_cam_imu = toQuaternionMsg(r.R_cam_imu);
     const Eigen::Vector3d rpy = rollPitchYawDeg(r.R_cam_imu);
     for (int i = 0; i < 3; ++i) {
@@ -289,9 +304,7 @@ bool AlignmentWrapper::Impl::onCalibrate(Calibrate::Request& req, Calibrate::Res
       res.std_dev_deg[i] = r.quality.std_dev_deg(i);
     }
     res.residual_rms_deg = r.quality.residual_rms_deg;
-  } else {
-    res.q_cam_imu.w = 1.0;
-  }
+  }  // else: all zeros, q_cam_imu included (has_estimate false)
   publishStatus();
   return true;
 }

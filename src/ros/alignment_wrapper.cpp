@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include <image_transport/camera_common.h>
+#include <ros/master.h>
 
 #include "alignment_wrapper_impl.h"
 #include "camera_imu_alignment/io/input_error.h"
@@ -121,6 +122,23 @@ std::string AlignmentWrapper::Impl::topicOf(InputStream stream) const {
   return toString(stream);
 }
 
+std::string AlignmentWrapper::Impl::otherTransportHint() const {
+  const std::string raw_topic = nh.resolveName("camera/image_raw");
+  const bool compressed = settings.image_transport == "compressed";
+  const std::string other = compressed ? raw_topic : raw_topic + "/compressed";
+  ros::master::V_TopicInfo topics;
+  if (!ros::master::getTopics(topics)) return "";
+  for (const ros::master::TopicInfo& topic : topics) {
+    if (topic.name == other) {
+      return "; " + other + " is published: image_transport " +
+             (compressed ? std::string("raw") : std::string("compressed")) +
+             " (alignment.launch / replay_bag.launch image_transport:=" +
+             (compressed ? "raw" : "compressed") + ")";
+    }
+  }
+  return "";
+}
+
 std::string AlignmentWrapper::Impl::cameraInputHint() const {
   if (streams.everSeen(InputStream::kCameraPose)) return "";
   const bool images = streams.everSeen(InputStream::kImage);
@@ -210,8 +228,9 @@ void AlignmentWrapper::Impl::warnSilentStreams() {
     }
     ROS_WARN(
         "%s: nothing on %s for 5 s while other inputs flow: wrong topic name (remap it), or "
-        "the driver stopped",
-        name.c_str(), topicOf(stream).c_str());
+        "the driver stopped%s",
+        name.c_str(), topicOf(stream).c_str(),
+        stream == InputStream::kImage ? otherTransportHint().c_str() : "");
   }
   // A 6-axis IMU has no magnetometer: said once, not warned about.
   if (!mag_absence_noted && !streams.everSeen(InputStream::kMagnetometer) &&
@@ -325,8 +344,15 @@ void AlignmentWrapper::Impl::onPoseRejected(const RejectedPose& rejected) {
 
 void AlignmentWrapper::Impl::onEstimate(const EstimateEvent& event) {
   const CalibrationProgress progress = progressOf(event, settings.online.max_std_dev_deg);
-  ROS_INFO("%s: estimate from %zu poses: %s", name.c_str(), event.window_poses,
-           progressText(progress).c_str());
+  // What the window held: poses at rest, camera orientations during motion, or both.
+  const int nodes = event.result.joint ? event.result.joint->motion_nodes : 0;
+  std::string from;
+  if (event.window_poses > 0 || nodes == 0) from = std::to_string(event.window_poses) + " poses";
+  if (nodes > 0) {
+    from += (from.empty() ? "" : " and ") + std::to_string(nodes) +
+            " camera orientations during motion";
+  }
+  ROS_INFO("%s: estimate from %s: %s", name.c_str(), from.c_str(), progressText(progress).c_str());
   if (event.gate.decision == GateDecision::kReject) {
     ROS_INFO_THROTTLE(2.0, "%s: estimate not broadcast: %s", name.c_str(), event.gate.why.c_str());
   } else if (event.gate.decision == GateDecision::kKeep) {

@@ -94,6 +94,9 @@ struct AlignmentWrapper::Impl {
   /// Which camera topic is silent while the other flows ("" when both or neither flow, or camera
   /// poses come): appended to a rest's "no camera data" so that it names the topic to fix.
   std::string cameraInputHint() const;
+  /// "" unless the image topic of the other transport (raw <-> compressed) is published: then
+  /// "; <topic> is published: image_transport <other> (...)", for the silent-image warning.
+  std::string otherTransportHint() const;
 
   // --- the calibrator's events
   void onPose(const StationaryPose& pose);

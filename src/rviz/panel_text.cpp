@@ -149,6 +149,29 @@ std::string rotateAboutText(double x, double y, double z) {
   return std::string("camera ") + names[dominant] + " " + vectorText(x, y, z, 2);
 }
 
+namespace {
+
+/// The rotation the motion made about each camera axis (waving) and the axes still to turn about.
+PanelRow motionTurnedRow(const AlignmentStatus& s) {
+  PanelRow row{"motion turned (x, y, z)", "-", RowLevel::kNormal,
+               "rotation the camera made about its x, y, z axes during the motion of the latest "
+               "estimate; every axis needs min_motion_rotation_deg"};
+  if (s.motion_nodes == 0) return row;
+  if (!allFinite({s.excitation_deg[0], s.excitation_deg[1], s.excitation_deg[2]})) {
+    row.value = "invalid (not finite)";
+    row.level = RowLevel::kError;
+    return row;
+  }
+  row.value = vectorText(s.excitation_deg[0], s.excitation_deg[1], s.excitation_deg[2], 0) + " deg";
+  if (!s.excitation_missing.empty()) {
+    row.value += "; turn about " + s.excitation_missing;
+    row.level = RowLevel::kWarning;
+  }
+  return row;
+}
+
+}  // namespace
+
 StatusView describeStatus(const AlignmentStatus& s) {
   StatusView view;
   view.state = s.state.empty() ? "(none)" : s.state;
@@ -192,6 +215,7 @@ StatusView describeStatus(const AlignmentStatus& s) {
        rotateAboutText(s.rotate_about_cam.x, s.rotate_about_cam.y, s.rotate_about_cam.z),
        s.state == AlignmentStatus::NOT_OBSERVABLE ? RowLevel::kWarning : RowLevel::kNormal,
        "unit axis in the camera frame to rotate the rig about next"});
+  rows.push_back(motionTurnedRow(s));
   rows.push_back({"IMU guidance", s.imu_guidance.empty() ? "-" : s.imu_guidance, RowLevel::kNormal,
                   "which rotation would calibrate the IMU parameters still "
                   "held at their priors"});

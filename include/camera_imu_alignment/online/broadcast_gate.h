@@ -44,11 +44,11 @@ struct GateOutcome {
 ///     >= consistency_level); pair modes: RMS pair residual <= max_residual_deg;
 ///   largest 1-sigma <= max_std_dev_deg;
 /// then against what is broadcast:
-///   no silent regression: an estimate with a larger 1-sigma from no more poses than the broadcast
-///     one is kept back, unless `fresh_start` (after a remount or a reset the old estimate is not
-///     a reference) or it differs significantly from the broadcast one (the mount changed while
-///     nothing was watching: their difference is judged against both covariances at
-///     remount.level);
+///   no silent regression: an estimate with a larger 1-sigma from no more poses and no more
+///     camera orientations during motion than the broadcast one is kept back, unless `fresh_start`
+///     (after a remount or a reset the old estimate is not a reference) or it differs significantly
+///     from the broadcast one (the mount changed while nothing was watching: their difference is
+///     judged against both covariances at remount.level);
 ///   min_change_deg: a change smaller than that is not re-broadcast (refines_broadcast when it is
 ///     more precise).
 /// A joint estimate with motion stands in for min_poses when its window holds min_motion_s of
@@ -56,6 +56,10 @@ struct GateOutcome {
 /// a recording without rests has no poses to count, and its statistical gates (consistency,
 /// 1-sigma) decide once the motion has shown its noise.
 bool enoughMotion(const JointResult& joint, const OnlineSettings& settings);
+
+/// The camera axes the motion turned less than min_motion_rotation_deg about, as the status says
+/// them ("camera z", "camera x and camera z"); "" when every axis turned enough.
+std::string unexcitedAxes(const MotionFigures& motion, const OnlineSettings& settings);
 
 GateOutcome judgeEstimate(const AlignmentResult& result, std::size_t window_poses,
                           const OnlineSettings& settings,
@@ -83,5 +87,17 @@ struct CalibrationCheck {
 std::optional<CalibrationCheck> checkCalibration(const AlignmentResult& estimate,
                                                  const BroadcastEstimate& current,
                                                  double consistency_level);
+
+/// A broadcast tf further than this many sigma (CalibrationCheck::sigmas) from the latest estimate
+/// is warned about while the gates keep the estimate back (also below the check's
+/// consistency_level: at 3 dof its default 0.001 is 4.0 sigma).
+constexpr double kBroadcastWarningSigmas = 3.0;
+
+/// "" unless the latest estimate (not the broadcast one) disagrees with the broadcast tf by more
+/// than kBroadcastWarningSigmas or fails the check: then what is wrong, with the figures, and the
+/// gate's reason why the tf stayed (`gate_why`). For the snapshot, the status and diagnostics
+/// (WARN).
+std::string broadcastWarning(const std::optional<CalibrationCheck>& check, bool latest_is_broadcast,
+                             const std::string& gate_why);
 
 }  // namespace camera_imu_alignment

@@ -47,10 +47,14 @@ struct OnlineCallbacks {
   /// A rest that did not become a pose; the reason says "not armed" for manual capture.
   std::function<void(const RejectedPose&)> on_pose_rejected;
   std::function<void(RejectReason, InputStream, const std::string&)> on_reject;
+  /// A solve was applied: called once per solve, after its state, message and broadcast
+  /// (on_broadcast) are in place; its state change comes through here, not through on_state.
   std::function<void(const EstimateEvent&)> on_estimate;
-  /// The static tf must say this now (and the file be saved when source is "estimated").
+  /// The static tf must say this now (and the file be saved when source is "estimated": then an
+  /// on_estimate follows).
   std::function<void(const BroadcastEstimate&)> on_broadcast;
   std::function<void(const RemountEvent&)> on_remount;
+  /// The state or its message changed other than by a solve (data flowing, a reset, a remount).
   std::function<void(CalibrationState, const std::string&)> on_state;
   /// Time jumped back on `stream` by jump_s (s): window and buffers cleared.
   std::function<void(double jump_s, InputStream stream)> on_clock_jump;

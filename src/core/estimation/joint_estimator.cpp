@@ -322,12 +322,21 @@ double largestMatrixDeviation(const JointResult& estimated) {
   return largest;
 }
 
+/// A chi-square tail probability for a note: "%.3g", or "< 1e-300" where it underflowed to 0 (a
+/// "p 0" or "p < 0" would read as a bug).
+std::string tailText(double p) {
+  if (!(p > 0.0)) return "< 1e-300";
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.3g", p);
+  return buffer;
+}
+
 std::string likelihoodRatioNote(double ratio, int dof, double p, const char* decision) {
   char buffer[256];
   std::snprintf(buffer, sizeof(buffer),
                 "T_g and T_a %s: likelihood ratio against holding them at identity chi2 %.1f on "
-                "%d dof, p %.3g",
-                decision, ratio, dof, p);
+                "%d dof, p %s",
+                decision, ratio, dof, tailText(p).c_str());
   return buffer;
 }
 
@@ -349,8 +358,8 @@ JointResult selectModel(const JointProblem& problem, const Eigen::Matrix3d& R_ca
       char buffer[160];
       std::snprintf(buffer, sizeof(buffer),
                     "T_g and T_a estimated: an entry is %.1f sigma from identity (likelihood ratio "
-                    "against identity p < %.3g)",
-                    z, p_bound);
+                    "against identity p %s)",
+                    z, (p_bound > 0.0 ? "< " + tailText(p_bound) : tailText(p_bound)).c_str());
       estimated.notes.push_back(buffer);
       return estimated;
     }

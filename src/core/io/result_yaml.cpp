@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 
 #include "camera_imu_alignment/io/csv_io.h"
@@ -26,6 +27,10 @@ std::string quoted(const std::string& s) {
   }
   return out + "\"";
 }
+
+/// R_cam_imu's quaternion and matrix (9 digits) of one file agree to about 1e-7 deg; a matrix
+/// typed with 4 decimals to about 0.01 deg. Further apart, one of them was edited.
+constexpr double kQuaternionMatrixToleranceDeg = 0.02;
 
 std::string row(const Eigen::Vector3d& v) {
   std::ostringstream out;
@@ -158,6 +163,7 @@ StoredCalibration readResultYaml(const std::string& path) {
     if (root["imu_frame"]) stored.imu_frame = root["imu_frame"].as<std::string>();
     const YAML::Node rot = root["R_cam_imu"];
     if (!rot) throw InputError(path + ": no R_cam_imu key");
+    std::optional<Eigen::Matrix3d> from_quaternion, from_matrix;
     if (rot["quaternion_xyzw"]) {
       const auto v = rot["quaternion_xyzw"].as<std::vector<double>>();
       if (v.size() != 4) throw InputError(path + ": R_cam_imu.quaternion_xyzw needs 4 numbers");
@@ -165,21 +171,35 @@ StoredCalibration readResultYaml(const std::string& path) {
       if (!q.coeffs().allFinite() || std::abs(q.norm() - 1.0) > kQuaternionNormTolerance) {
         throw InputError(path + ": R_cam_imu.quaternion_xyzw is not a unit quaternion");
       }
-      stored.R_cam_imu = q.normalized().toRotationMatrix();
-    } else if (rot["matrix"]) {
+      from_quaternion = q.normalized().toRotationMatrix();
+    }
+    if (rot["matrix"]) {
       const auto m = rot["matrix"].as<std::vector<std::vector<double>>>();
       if (m.size() != 3) throw InputError(path + ": R_cam_imu.matrix needs 3 rows");
+      Eigen::Matrix3d R;
       for (int i = 0; i < 3; ++i) {
         if (m[i].size() != 3) throw InputError(path + ": R_cam_imu.matrix needs 3 columns");
-        for (int k = 0; k < 3; ++k) stored.R_cam_imu(i, k) = m[i][k];
+        for (int k = 0; k < 3; ++k) R(i, k) = m[i][k];
       }
-      if (!isRotationMatrix(stored.R_cam_imu, 1e-4)) {
+      if (!isRotationMatrix(R, 1e-4)) {
         throw InputError(path + ": R_cam_imu.matrix is not a rotation matrix");
       }
-      stored.R_cam_imu = projectToSO3(stored.R_cam_imu);
-    } else {
+      from_matrix = projectToSO3(R);
+    }
+    if (!from_quaternion && !from_matrix) {
       throw InputError(path + ": R_cam_imu has neither quaternion_xyzw nor matrix");
     }
+    // Both written (as this package writes them): a hand edit of one of them is not read silently.
+    if (from_quaternion && from_matrix) {
+      const double apart_deg = rad2deg(geodesicDistance(*from_quaternion, *from_matrix));
+      if (apart_deg > kQuaternionMatrixToleranceDeg) {
+        std::ostringstream out;
+        out << path << ": R_cam_imu.quaternion_xyzw and R_cam_imu.matrix are " << apart_deg
+            << " deg apart (one was edited?): make them agree, or delete one of them";
+        throw InputError(out.str());
+      }
+    }
+    stored.R_cam_imu = from_quaternion ? *from_quaternion : *from_matrix;
     const YAML::Node quality = root["quality"];
     if (quality && quality["std_dev_deg"]) {
       const auto v = quality["std_dev_deg"].as<std::vector<double>>();

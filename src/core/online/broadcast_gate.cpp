@@ -2,9 +2,12 @@
 #include "camera_imu_alignment/online/broadcast_gate.h"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
+#include <vector>
 
 #include "camera_imu_alignment/solver/rotation_math.h"
 
@@ -47,12 +50,43 @@ std::optional<Difference> differenceOf(const AlignmentResult& estimate,
   return d;
 }
 
+/// Camera orientations during motion behind an estimate (0 without the joint estimate's motion).
+int motionNodesOf(const AlignmentResult& r) {
+  return r.joint && r.joint->ok ? std::max(0, r.joint->motion_nodes) : 0;
+}
+int motionNodesOf(const std::optional<AlignmentResult>& r) { return r ? motionNodesOf(*r) : 0; }
+
+/// "12 poses", "302 camera orientations during motion" or both.
+std::string dataText(std::size_t poses, int motion_nodes) {
+  std::string out;
+  if (poses > 0 || motion_nodes == 0) out = std::to_string(poses) + " poses";
+  if (motion_nodes > 0) {
+    out += (out.empty() ? "" : " and ") + std::to_string(motion_nodes) +
+           " camera orientations during motion";
+  }
+  return out;
+}
+
 }  // namespace
 
 bool enoughMotion(const JointResult& joint, const OnlineSettings& settings) {
   const MotionFigures& m = joint.motion;
   return joint.motion_nodes > 0 && m.excitation_duration_s >= settings.min_motion_s &&
          rad2deg(m.excitation_rad.minCoeff()) >= settings.min_motion_rotation_deg;
+}
+
+std::string unexcitedAxes(const MotionFigures& motion, const OnlineSettings& settings) {
+  std::vector<std::string> axes;
+  for (int i = 0; i < 3; ++i) {
+    if (!(rad2deg(motion.excitation_rad(i)) >= settings.min_motion_rotation_deg)) {
+      axes.push_back(std::string("camera ") + "xyz"[i]);
+    }
+  }
+  std::string out;
+  for (std::size_t k = 0; k < axes.size(); ++k) {
+    out += (k == 0 ? "" : k + 1 == axes.size() ? " and " : ", ") + axes[k];
+  }
+  return out;
 }
 
 double differenceSignificance(const AlignmentResult& result, const BroadcastEstimate& broadcast) {
@@ -81,6 +115,18 @@ std::optional<CalibrationCheck> checkCalibration(const AlignmentResult& estimate
        << (check.consistent ? "still right" : "NOT consistent with the new poses: recalibrate");
   check.text = text.str();
   return check;
+}
+
+std::string broadcastWarning(const std::optional<CalibrationCheck>& check, bool latest_is_broadcast,
+                             const std::string& gate_why) {
+  if (!check || latest_is_broadcast) return "";
+  if (check->consistent && !(check->sigmas > kBroadcastWarningSigmas)) return "";
+  char buffer[160];
+  std::snprintf(buffer, sizeof(buffer),
+                "the broadcast tf is %.2f deg (%.1f sigma) from the latest estimate, which the "
+                "gates kept back: ",
+                check->error_deg, check->sigmas);
+  return buffer + (gate_why.empty() ? std::string("no reason given") : gate_why);
 }
 
 GateOutcome judgeEstimate(const AlignmentResult& r, std::size_t window_poses,
@@ -130,11 +176,14 @@ GateOutcome judgeEstimate(const AlignmentResult& r, std::size_t window_poses,
         << ": more poses, rotated about other axes";
   } else if (broadcast && !fresh_start && sigma > broadcast->maxStdDevDeg() &&
              window_poses <= static_cast<std::size_t>(broadcast->poses) &&
+             motionNodesOf(r) <= motionNodesOf(broadcast->result) &&
              differenceSignificance(r, *broadcast) >= settings.remount.level) {
     out.decision = GateDecision::kKeep;
-    why << "1-sigma " << sigma << " deg from " << window_poses
-        << " poses is larger than the broadcast estimate's " << broadcast->maxStdDevDeg()
-        << " deg from " << broadcast->poses << ": kept back (no silent regression)";
+    why << "1-sigma " << sigma << " deg from " << dataText(window_poses, motionNodesOf(r))
+        << " is larger than the broadcast estimate's " << broadcast->maxStdDevDeg() << " deg from "
+        << dataText(static_cast<std::size_t>(std::max(0, broadcast->poses)),
+                    motionNodesOf(broadcast->result))
+        << ": kept back (no silent regression)";
   } else if (broadcast && rad2deg(rotationAngle(broadcast->R_cam_imu.transpose() * r.R_cam_imu)) <=
                               settings.min_change_deg) {
     out.decision = GateDecision::kKeep;
@@ -142,7 +191,7 @@ GateOutcome judgeEstimate(const AlignmentResult& r, std::size_t window_poses,
     why << "within min_change_deg " << settings.min_change_deg << " of the broadcast estimate";
     if (out.refines_broadcast) {
       why << " (its 1-sigma " << sigma << " deg from " << window_poses
-          << " poses replaces the broadcast one's in the saved file)";
+          << " poses becomes the broadcast estimate's)";
     }
   } else {
     out.decision = GateDecision::kBroadcast;

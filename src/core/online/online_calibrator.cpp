@@ -65,11 +65,22 @@ struct OnlineCalibrator::Impl {
   bool capture_armed = false;
 
   bool joint() const { return usesJointEstimate(pipeline_settings.imu_orientation); }
+  /// True while an estimate is applied: its state change is reported by the on_estimate that
+  /// follows (one status per solve, with its own message), not by on_state.
+  bool applying_estimate = false;
   void setState(CalibrationState s, const std::string& text) {
     const bool changed = s != state || text != message;
     state = s;
     message = text;
-    if (changed && callbacks.on_state) callbacks.on_state(state, message);
+    if (changed && !applying_estimate && callbacks.on_state) callbacks.on_state(state, message);
+  }
+  /// The estimate's effects (state, broadcast), then on_estimate once they are all in place.
+  template <typename Effects>
+  void applyThenReport(const EstimateEvent& event, Effects effects) {
+    applying_estimate = true;
+    effects();
+    applying_estimate = false;
+    if (callbacks.on_estimate) callbacks.on_estimate(event);
   }
   /// waiting_for_data -> collecting once IMU and camera data flow.
   void refreshWaiting() {
@@ -329,23 +340,25 @@ void OnlineCalibrator::Impl::applyRemount(const SolveOutput& output) {
 
 void OnlineCalibrator::Impl::applyEstimate(EstimateEvent event) {
   last_estimate = event;
-  if (callbacks.on_estimate) callbacks.on_estimate(event);
-  switch (event.gate.decision) {
-    case GateDecision::kReject:
-      setState(event.result.status == SolveStatus::kNotObservable ? CalibrationState::kNotObservable
-               : recalibrating                                    ? CalibrationState::kRecalibrating
-               : broadcast && !fresh_start                        ? CalibrationState::kCalibrated
-                                                                  : CalibrationState::kCollecting,
-               "estimate not broadcast: " + event.gate.why);
-      return;
-    case GateDecision::kKeep:
-      if (event.gate.refines_broadcast) refineBroadcast(event.result, event.window_poses);
-      setState(CalibrationState::kCalibrated, "the broadcast estimate stays: " + event.gate.why);
-      return;
-    case GateDecision::kBroadcast:
-      doBroadcast(event.result, event.window_poses);
-      return;
-  }
+  applyThenReport(event, [&] {
+    switch (event.gate.decision) {
+      case GateDecision::kReject:
+        setState(event.result.status == SolveStatus::kNotObservable
+                     ? CalibrationState::kNotObservable
+                 : recalibrating             ? CalibrationState::kRecalibrating
+                 : broadcast && !fresh_start ? CalibrationState::kCalibrated
+                                             : CalibrationState::kCollecting,
+                 "estimate not broadcast: " + event.gate.why);
+        return;
+      case GateDecision::kKeep:
+        if (event.gate.refines_broadcast) refineBroadcast(event.result, event.window_poses);
+        setState(CalibrationState::kCalibrated, "the broadcast estimate stays: " + event.gate.why);
+        return;
+      case GateDecision::kBroadcast:
+        doBroadcast(event.result, event.window_poses);
+        return;
+    }
+  });
 }
 
 void OnlineCalibrator::Impl::doBroadcast(const AlignmentResult& result, std::size_t poses) {
@@ -464,10 +477,11 @@ CalibrateOutcome OnlineCalibrator::calibrateNow(bool force) {
   if (forcible) {
     event.forced = true;
     impl_->last_estimate = event;
-    if (impl_->callbacks.on_estimate) impl_->callbacks.on_estimate(event);
-    impl_->doBroadcast(event.result, poses);
-    impl_->setState(CalibrationState::kCalibrated,
-                    "broadcast on request (force) although: " + event.gate.why);
+    impl_->applyThenReport(event, [&] {
+      impl_->doBroadcast(event.result, poses);
+      impl_->setState(CalibrationState::kCalibrated,
+                      "broadcast on request (force) although: " + event.gate.why);
+    });
   } else {
     impl_->applyEstimate(event);
   }
@@ -571,17 +585,9 @@ CalibrationSnapshot OnlineCalibrator::snapshot(SnapshotContents contents) const 
   s.remount_events = c.remount_events;
   if (c.last_estimate && c.broadcast) {
     s.check = checkCalibration(c.last_estimate->result, *c.broadcast, c.settings.consistency_level);
-    if (s.check && !s.check->consistent && !s.latest_is_broadcast) {
-      char buffer[160];
-      std::snprintf(buffer, sizeof(buffer),
-                    "the broadcast tf is %.2f deg (%.1f sigma) from the latest estimate, which the "
-                    "gates kept back: ",
-                    s.check->error_deg, s.check->sigmas);
-      s.broadcast_warning =
-          buffer + (c.last_estimate->gate.why.empty() ? std::string("no reason given")
-                                                      : c.last_estimate->gate.why);
-      s.message += "; " + s.broadcast_warning;
-    }
+    s.broadcast_warning =
+        broadcastWarning(s.check, s.latest_is_broadcast, c.last_estimate->gate.why);
+    if (!s.broadcast_warning.empty()) s.message += "; " + s.broadcast_warning;
   }
   s.remounts = c.remounts;
   // The vertical at the newest rest in the camera frame: R_world_imu's z is up (gravity).
