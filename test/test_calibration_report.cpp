@@ -74,7 +74,8 @@ std::string blockWith(const std::vector<std::string>& blocks, const std::string&
 }
 
 /// A YAML list of 4 lists of 4 numbers -> its top-left 3x3 block; checks the last row / column.
-Eigen::Matrix3d rotationOfTransform(const YAML::Node& T) {
+Eigen::Matrix3d rotationOfTransform(const YAML::Node& T,
+                                    const Eigen::Vector3d& t = Eigen::Vector3d::Zero()) {
   EXPECT_TRUE(T.IsSequence());
   EXPECT_EQ(T.size(), 4u);
   Eigen::Matrix3d R = Eigen::Matrix3d::Constant(std::nan(""));
@@ -86,7 +87,8 @@ Eigen::Matrix3d rotationOfTransform(const YAML::Node& T) {
       if (i < 3 && k < 3) {
         R(i, k) = value;
       } else {
-        EXPECT_EQ(value, (i == 3 && k == 3) ? 1.0 : 0.0) << "row " << i << " col " << k;
+        const double expected = i == 3 ? (k == 3 ? 1.0 : 0.0) : t(i);
+        EXPECT_NEAR(value, expected, 1e-9) << "row " << i << " col " << k;  // 9 digits
       }
     }
   }
@@ -192,6 +194,47 @@ TEST(ExportBlocks, EveryBlockRoundTripsToTheRotation) {
   }
 }
 
+// Where the motion measured T_cam_imu's translation, every block carries it in its own convention
+// (Kalibr t_cam_imu, OpenVINS and VINS t_imu_cam = -R_cam_imu^T t_cam_imu, tf the IMU's position
+// in the camera frame) and says its 1-sigma; where not, 0 and the reason.
+TEST(ExportBlocks, AMeasuredTranslationInEveryConventionAndAnUnmeasuredOneSaysWhy) {
+  std::mt19937_64 rng(21);
+  const Eigen::Matrix3d R_cam_imu = randomRotation(rng);
+  ExportTranslation t;
+  t.measured = true;
+  t.p_cam_imu_m = Eigen::Vector3d(-0.0449, -0.0206, -0.0086);
+  t.sigma_m = Eigen::Vector3d(0.002, 0.003, 0.004);
+  const std::vector<std::string> blocks =
+      splitBlocks(exportBlocks(R_cam_imu, "cam", "imu", std::nullopt, t));
+  ASSERT_EQ(blocks.size(), 4u);
+  const Eigen::Vector3d t_imu_cam = -(R_cam_imu.transpose() * t.p_cam_imu_m);
+  const YAML::Node kalibr = YAML::Load(blockWith(blocks, "Kalibr"));
+  expectMatrixNear(rotationOfTransform(kalibr["cam0"]["T_cam_imu"], t.p_cam_imu_m), R_cam_imu,
+                   "Kalibr");
+  const YAML::Node openvins = YAML::Load(blockWith(blocks, "OpenVINS"));
+  expectMatrixNear(rotationOfTransform(openvins["cam0"]["T_imu_cam"], t_imu_cam),
+                   R_cam_imu.transpose(), "OpenVINS");
+  const YAML::Node vins = YAML::Load(blockWith(blocks, "VINS-Mono"))["extrinsicTranslation"];
+  ASSERT_TRUE(vins.IsMap());
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(vins["data"][i].as<double>(), t_imu_cam(i), 1e-9);
+  const TfLine tf = parseTfLine(blockWith(blocks, "static_transform_publisher"));
+  EXPECT_LT((tf.translation - t.p_cam_imu_m).norm(), 1e-9) << tf.translation.transpose();
+  for (const std::string& b : blocks) {
+    EXPECT_NE(b.find("translation measured during motion, 1-sigma"), std::string::npos) << b;
+  }
+  // Not measured: zeros, no extrinsicTranslation, and the reason in every block.
+  ExportTranslation none;
+  none.not_measured_reason = "not measured: rests only";
+  const std::vector<std::string> plain =
+      splitBlocks(exportBlocks(R_cam_imu, "cam", "imu", std::nullopt, none));
+  EXPECT_FALSE(YAML::Load(blockWith(plain, "VINS-Mono"))["extrinsicTranslation"]);
+  EXPECT_EQ(parseTfLine(blockWith(plain, "static_transform_publisher")).translation,
+            Eigen::Vector3d::Zero());
+  for (const std::string& b : plain) {
+    EXPECT_NE(b.find("not measured: rests only (0 here)"), std::string::npos) << b;
+  }
+}
+
 TEST(FormatSummary, ShowsStatusNumbersRejectionsAndEndsWithTheBlocks) {
   std::mt19937_64 rng(13);
   const Eigen::Matrix3d R_cam_imu = randomRotation(rng);
@@ -200,7 +243,8 @@ TEST(FormatSummary, ShowsStatusNumbersRejectionsAndEndsWithTheBlocks) {
   EXPECT_ROTATION_NEAR_DEG(in.result.R_cam_imu, R_cam_imu, 1.0);
 
   const std::string text = formatSummary(in);
-  const std::string blocks = exportBlocks(in.result.R_cam_imu, in.camera_frame, in.imu_frame);
+  const std::string blocks = exportBlocks(in.result.R_cam_imu, in.camera_frame, in.imu_frame,
+                                          std::nullopt, exportTranslationOf(in.result));
   ASSERT_GE(text.size(), blocks.size());
   EXPECT_EQ(text.substr(text.size() - blocks.size()), blocks);
   EXPECT_NE(text.find("status: ok"), std::string::npos) << text;

@@ -272,7 +272,7 @@ TEST(ResultYaml, HasEveryKeyOfTheConventions) {
   for (int i = 0; i < 3; ++i) {
     ASSERT_EQ(m[i].size(), 3u);
     ASSERT_EQ(T[i].size(), 4u);
-    EXPECT_EQ(T[i][3], 0.0);  // zero translation
+    EXPECT_EQ(T[i][3], 0.0);  // no joint estimate: the translation is not measured, zero
     for (int k = 0; k < 3; ++k) {
       EXPECT_NEAR(m[i][k], X(i, k), 1e-9);
       EXPECT_NEAR(T[i][k], X(i, k), 1e-9);
@@ -289,6 +289,24 @@ TEST(ResultYaml, HasEveryKeyOfTheConventions) {
   EXPECT_EQ(quality["std_dev_deg"].as<std::vector<double>>(),
             (std::vector<double>{0.03, 0.04, 0.05}));
   EXPECT_EQ(quality["iterations"].as<int>(), 9);
+  EXPECT_FALSE(y["translation"]["measured"].as<bool>());
+  EXPECT_NE(y["translation"]["source"].as<std::string>().find("keep your measured translation"),
+            std::string::npos);
+  // Measured by the motion: T_cam_imu's translation, its 1-sigma.
+  AlignmentResult with_lever_arm = knownResult(X);
+  JointResult joint;
+  joint.ok = true;
+  joint.motion_nodes = 500;
+  joint.lever_arm_in_model = joint.lever_arm_measured = true;
+  joint.p_cam_imu_m = Eigen::Vector3d(-0.0449, -0.0206, -0.0086);
+  joint.p_cam_imu_sigma_m = Eigen::Vector3d(0.002, 0.003, 0.004);
+  with_lever_arm.joint = joint;
+  const YAML::Node measured = YAML::Load(resultToYaml(with_lever_arm, meta));
+  const auto Tm = measured["T_cam_imu"].as<std::vector<std::vector<double>>>();
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(Tm[i][3], joint.p_cam_imu_m(i), 1e-9);
+  EXPECT_TRUE(measured["translation"]["measured"].as<bool>());
+  EXPECT_EQ(measured["translation"]["sigma_m"].as<std::vector<double>>(),
+            (std::vector<double>{0.002, 0.003, 0.004}));
   AlignmentResult unobservable = knownResult(X);
   unobservable.quality.observable = false;
   EXPECT_FALSE(YAML::Load(resultToYaml(unobservable, meta))["quality"]["observable"].as<bool>());

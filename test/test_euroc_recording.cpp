@@ -4,11 +4,13 @@
 // authors' own Kalibr estimate: about 0.15-0.2 deg is the floor of what it can confirm). Skips
 // when the recording is absent.
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <filesystem>
 #include <regex>
 #include <string>
+#include <vector>
 
 #include "test_helpers.h"
 #include "tool_runner.h"
@@ -91,6 +93,21 @@ TEST_F(EurocRecording, DefaultsGiveThePublishedRotationWithAnHonestSigmaAndAZero
   EXPECT_NE(imu.find("measured on the recording"), std::string::npos) << imu;
   EXPECT_TRUE(std::regex_search(imu, m, std::regex(R"(accelerometer_noise_density: ([0-9.e-]+))")));
   EXPECT_GT(std::stod(m[1]), 0.0);
+  // T_cam_imu's translation, measured during the motion, against the published one: the IMU's
+  // position in the camera frame -R_BS^T t_BS = [-0.0449, -0.0206, -0.0086] m (published.yaml).
+  const YAML::Node translation = YAML::LoadFile(output)["translation"];
+  ASSERT_TRUE(translation["measured"].as<bool>()) << test::readFile(output);
+  const auto p = translation["p_cam_imu_m"].as<std::vector<double>>();
+  const auto sigma = translation["sigma_m"].as<std::vector<double>>();
+  const double published[3] = {-0.0449, -0.0206, -0.0086};
+  double squared = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_LE(std::abs(p[axis] - published[axis]), 3.0 * sigma[axis]) << "axis " << axis;
+    EXPECT_LT(sigma[axis], 0.01) << "axis " << axis;  // a measurement, not the 0.2 m prior
+    squared += std::pow(p[axis] - published[axis], 2);
+  }
+  std::printf("translation [%.4f %.4f %.4f] m +- [%.4f %.4f %.4f], %.1f mm from the published\n",
+              p[0], p[1], p[2], sigma[0], sigma[1], sigma[2], 1e3 * std::sqrt(squared));
 }
 
 TEST_F(EurocRecording, ShortClipsAreCoveredByTheirSigmaOrDeclined) {

@@ -73,6 +73,10 @@ TEST(MotionAcceleration, ExactDataGiveTheTruth) {
               r.std_dev_deg.norm(), 1e3 * r.timeshift_cam_imu_s, r.message.c_str());
   EXPECT_LT(error_deg, 0.01);
   EXPECT_NEAR(r.timeshift_cam_imu_s, w.timeshift_s, 1e-4);
+  // The simulated IMU sits at the camera's centre: T_cam_imu's translation is zero, measured.
+  EXPECT_TRUE(r.lever_arm_in_model);
+  EXPECT_TRUE(r.lever_arm_measured) << r.p_cam_imu_sigma_m.transpose();
+  EXPECT_LT(r.p_cam_imu_m.norm(), 1e-3) << r.p_cam_imu_m.transpose();
 }
 
 }  // namespace
@@ -106,6 +110,15 @@ TEST(MotionAcceleration, ConsumerGradeWithItsErrors) {
     // Without the acceleration model the gyro's axis misalignment leaves ~0.4 deg per axis.
     EXPECT_LT(error_deg, 0.08) << "seed " << seed;
     EXPECT_LT(r.std_dev_deg.maxCoeff(), 0.1) << "seed " << seed;
+    // The lever arm (truth zero) is measured and within 3 sigma of the truth on every axis.
+    std::printf("  lever arm [%.4f %.4f %.4f] m +- [%.4f %.4f %.4f]\n", r.p_cam_imu_m(0),
+                r.p_cam_imu_m(1), r.p_cam_imu_m(2), r.p_cam_imu_sigma_m(0), r.p_cam_imu_sigma_m(1),
+                r.p_cam_imu_sigma_m(2));
+    EXPECT_TRUE(r.lever_arm_measured) << "seed " << seed;
+    for (int axis = 0; axis < 3; ++axis) {
+      EXPECT_LT(std::abs(r.p_cam_imu_m(axis)), 3.0 * r.p_cam_imu_sigma_m(axis))
+          << "seed " << seed << " axis " << axis;
+    }
   }
 }
 

@@ -54,16 +54,31 @@ struct ReportInput {
 /// the truth when given (report_figures.h), then exportBlocks().
 std::string formatSummary(const ReportInput& input);
 
-/// Ready-to-paste blocks, each introduced by a comment line naming the tool and the convention:
-///  - Kalibr camchain-imucam.yaml: T_cam_imu (4x4, zero translation),
-///  - OpenVINS kalibr_imucam_chain.yaml: T_imu_cam (4x4, R_imu_cam = R_cam_imu^T),
-///  - VINS-Mono / VINS-Fusion: extrinsicRotation (opencv-matrix, R_imu_cam: camera to body/IMU),
-///  - `rosrun tf2_ros static_transform_publisher 0 0 0 qx qy qz qw <camera_frame> <imu_frame>`
+/// T_cam_imu's translation for the export blocks: the IMU's position in the camera frame (m) with
+/// its 1-sigma where the motion measured it, else zeros and the reason it was not measured.
+struct ExportTranslation {
+  bool measured = false;
+  Eigen::Vector3d p_cam_imu_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sigma_m = Eigen::Vector3d::Zero();
+  std::string not_measured_reason = "not measured: keep your measured translation";
+};
+/// The result's (translationNotMeasuredReason, result_yaml.h).
+ExportTranslation exportTranslationOf(const AlignmentResult& result);
+
+/// Ready-to-paste blocks, each introduced by comment lines naming the tool, the convention and
+/// whether the translation was measured (with its 1-sigma) or why not (then 0):
+///  - Kalibr camchain-imucam.yaml: T_cam_imu (4x4; translation p_cam_imu),
+///  - OpenVINS kalibr_imucam_chain.yaml: T_imu_cam (4x4, R_imu_cam = R_cam_imu^T,
+///    t_imu_cam = -R_imu_cam p_cam_imu),
+///  - VINS-Mono / VINS-Fusion: extrinsicRotation (opencv-matrix, R_imu_cam: camera to body/IMU)
+///    and, when measured, extrinsicTranslation (t_imu_cam),
+///  - `rosrun tf2_ros static_transform_publisher x y z qx qy qz qw <camera_frame> <imu_frame>`
 ///    (parent camera, child IMU: the transform maps IMU-frame points into the camera frame).
 /// With timeshift_cam_imu_s (estimated from motion) Kalibr's block carries it as
 /// timeshift_cam_imu (t_imu = t_cam + timeshift_cam_imu).
 std::string exportBlocks(const Eigen::Matrix3d& R_cam_imu, const std::string& camera_frame,
                          const std::string& imu_frame,
-                         std::optional<double> timeshift_cam_imu_s = std::nullopt);
+                         std::optional<double> timeshift_cam_imu_s = std::nullopt,
+                         const ExportTranslation& translation = ExportTranslation());
 
 }  // namespace camera_imu_alignment

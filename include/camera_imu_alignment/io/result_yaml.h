@@ -1,6 +1,7 @@
 // The calibration result YAML of doc/CONVENTIONS.md (R_cam_imu as quaternion_xyzw and matrix,
-// Kalibr-style T_cam_imu with zero translation, quality block), plus extra keys: method, two_step,
-// observability details, per-pair residuals, R_imu_cam.
+// Kalibr-style T_cam_imu whose translation is the lever arm where the motion measured it, else
+// zero, with the translation block saying which; quality block), plus extra keys: method,
+// two_step, observability details, per-pair residuals, R_imu_cam.
 #pragma once
 
 #include <Eigen/Core>
@@ -20,6 +21,11 @@ struct ResultMetadata {
 
 /// The result document as YAML text.
 std::string resultToYaml(const AlignmentResult& result, const ResultMetadata& meta);
+
+/// Why T_cam_imu's translation was not measured, for the outputs ("" when it was: the joint
+/// estimate's lever arm, JointResult::lever_arm_measured): rests only, no camera positions during
+/// the motion, or not determined by it. Ends with the advice to keep the user's measured one.
+std::string translationNotMeasuredReason(const AlignmentResult& result);
 
 /// Writes the YAML atomically (temporary file in the same folder + rename), so a reader never sees
 /// a half-written file and a failed write leaves any previous file intact. Throws InputError.

@@ -254,6 +254,15 @@ struct JointResult {
   double timeshift_cam_imu_s = 0;
   double timeshift_sigma_s = 0;
   bool timeshift_estimated = false;
+  /// The IMU's position in the camera frame (m): T_cam_imu's translation (p_cam = R_cam_imu p_imu
+  /// + p_cam_imu_m), from the acceleration model during motion (AccelLink: the camera's positions
+  /// and the accelerometer); lever_arm_in_model false (and zeros) without it.
+  Eigen::Vector3d p_cam_imu_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d p_cam_imu_sigma_m = Eigen::Vector3d::Zero();  ///< 1-sigma per camera axis (m)
+  bool lever_arm_in_model = false;
+  /// Determined by the data: every axis' 1-sigma well below its prior (lever_arm_prior_m); else
+  /// the value rests on the prior (zero) and is not a measurement.
+  bool lever_arm_measured = false;
   int motion_nodes = 0;      ///< motion nodes used (JointProblem::motion_frames)
   MotionFigures motion;      ///< the motion's figures for the report
   int rests_used = 0;        ///< rests used (JointProblem::poses)

@@ -252,6 +252,18 @@ bool fillResult(const JointProblem& problem, const State& state, const BuiltProb
         blockSigma(*used, requested, state.timeshift.data(), Eigen::VectorXd::Zero(1), scale)(0);
   }
 
+  // The lever arm (acceleration model only): measured when the data determine every axis.
+  if (requested.count(state.lever_arm_m.data()) > 0) {
+    const Eigen::VectorXd prior = Eigen::Vector3d::Constant(settings.lever_arm_prior_m);
+    const Eigen::VectorXd sigma =
+        blockSigma(*used, requested, state.lever_arm_m.data(), prior, scale);
+    result->lever_arm_in_model = true;
+    result->p_cam_imu_m =
+        Eigen::Vector3d(state.lever_arm_m[0], state.lever_arm_m[1], state.lever_arm_m[2]);
+    result->p_cam_imu_sigma_m = sigma;
+    result->lever_arm_measured = informedByTheData(sigma * unscale, prior);
+  }
+
   in.magnetometer_used = observability.magnetometer_used;
   const Eigen::VectorXd soft_sigma =
       blockSigma(*used, requested, state.soft_iron.data(), soft_prior, scale);

@@ -11,6 +11,7 @@
 
 #include "camera_imu_alignment/io/joint_yaml.h"
 #include "camera_imu_alignment/io/report_figures.h"
+#include "camera_imu_alignment/io/result_yaml.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "report_text.h"
 
@@ -23,59 +24,83 @@ using report_text::fixed;
 using report_text::fixedList;
 using report_text::hasAxisAdvice;
 
-/// The four rows of the 4x4 transform [R 0; 0 1] as YAML flow sequences, one per line. A template
+/// The four rows of the 4x4 transform [R t; 0 1] as YAML flow sequences, one per line. A template
 /// so that R may be a transpose expression (no temporary).
 template <typename Derived>
-std::string transformRows(const Eigen::MatrixBase<Derived>& R, const std::string& indent) {
+std::string transformRows(const Eigen::MatrixBase<Derived>& R, const Eigen::Vector3d& t,
+                          const std::string& indent) {
   std::string rows;
   for (int i = 0; i < 3; ++i) {
-    rows += indent + "- [" + exact(R(i, 0)) + ", " + exact(R(i, 1)) + ", " + exact(R(i, 2)) +
-            ", 0.0]\n";
+    rows += indent + "- [" + exact(R(i, 0)) + ", " + exact(R(i, 1)) + ", " + exact(R(i, 2)) + ", " +
+            (t(i) == 0.0 ? std::string("0.0") : exact(t(i))) + "]\n";
   }
   return rows + indent + "- [0.0, 0.0, 0.0, 1.0]\n";
 }
 
-std::string kalibrBlock(const Eigen::Matrix3d& R_cam_imu, std::optional<double> timeshift_s) {
+/// The comment line about the translation: measured (with its 1-sigma) or why not.
+std::string translationComment(const ExportTranslation& t) {
+  if (!t.measured) return "# translation: " + t.not_measured_reason + " (0 here).\n";
+  return "# translation measured during motion, 1-sigma per camera axis " +
+         fixedList(t.sigma_m, 4) + " m.\n";
+}
+
+std::string kalibrBlock(const Eigen::Matrix3d& R_cam_imu, const ExportTranslation& t,
+                        std::optional<double> timeshift_s) {
   std::string block =
       "# Kalibr camchain-imucam.yaml: T_cam_imu maps IMU-frame points into the camera frame\n"
-      "# (p_cam = T_cam_imu * p_imu); rotation only: translation not estimated (0 here).\n"
-      "cam0:\n"
-      "  T_cam_imu:\n" +
-      transformRows(R_cam_imu, "  ");
+      "# (p_cam = T_cam_imu * p_imu);\n" +
+      translationComment(t) + "cam0:\n  T_cam_imu:\n" +
+      transformRows(R_cam_imu, t.p_cam_imu_m, "  ");
   if (timeshift_s)
     block += "  timeshift_cam_imu: " + exact(*timeshift_s) + "  # t_imu = t_cam + this\n";
   return block;
 }
 
-std::string openVinsBlock(const Eigen::Matrix3d& R_cam_imu) {
+std::string openVinsBlock(const Eigen::Matrix3d& R_cam_imu, const ExportTranslation& t) {
+  const Eigen::Vector3d t_imu_cam = -(R_cam_imu.transpose() * t.p_cam_imu_m);
   return "# OpenVINS kalibr_imucam_chain.yaml: T_imu_cam = T_cam_imu^-1, R_imu_cam = R_cam_imu^T\n"
-         "# (p_imu = T_imu_cam * p_cam); rotation only, keep your measured translation.\n"
-         "cam0:\n"
-         "  T_imu_cam:\n" +
-         transformRows(R_cam_imu.transpose(), "    ");
+         "# (p_imu = T_imu_cam * p_cam);\n" +
+         translationComment(t) + "cam0:\n  T_imu_cam:\n" +
+         transformRows(R_cam_imu.transpose(), t_imu_cam, "    ");
 }
 
-std::string vinsBlock(const Eigen::Matrix3d& R_cam_imu) {
+std::string vinsBlock(const Eigen::Matrix3d& R_cam_imu, const ExportTranslation& t) {
   std::string data;  // R_imu_cam row by row: R_imu_cam(i, k) = R_cam_imu(k, i)
   for (int i = 0; i < 3; ++i) {
     data += (i == 0 ? "   data: [" : ",\n          ");
     data += exact(R_cam_imu(0, i)) + ", " + exact(R_cam_imu(1, i)) + ", " + exact(R_cam_imu(2, i));
   }
-  return "# VINS-Mono / VINS-Fusion config: extrinsicRotation = R_imu_cam (camera to body/IMU,\n"
-         "# p_imu = R * p_cam, row-major); VINS-Fusion's body_T_cam0 has the same rotation.\n"
-         "extrinsicRotation: !!opencv-matrix\n"
-         "   rows: 3\n"
-         "   cols: 3\n"
-         "   dt: d\n" +
-         data + "]\n";
+  std::string block =
+      "# VINS-Mono / VINS-Fusion config: extrinsicRotation = R_imu_cam (camera to body/IMU,\n"
+      "# p_imu = R * p_cam, row-major); VINS-Fusion's body_T_cam0 has the same rotation;\n" +
+      translationComment(t) +
+      "extrinsicRotation: !!opencv-matrix\n"
+      "   rows: 3\n"
+      "   cols: 3\n"
+      "   dt: d\n" +
+      data + "]\n";
+  if (t.measured) {
+    const Eigen::Vector3d t_imu_cam = -(R_cam_imu.transpose() * t.p_cam_imu_m);
+    block +=
+        "extrinsicTranslation: !!opencv-matrix  # the camera in the IMU frame (m)\n"
+        "   rows: 3\n"
+        "   cols: 1\n"
+        "   dt: d\n"
+        "   data: [" +
+        exact(t_imu_cam(0)) + ", " + exact(t_imu_cam(1)) + ", " + exact(t_imu_cam(2)) + "]\n";
+  }
+  return block;
 }
 
-std::string tfBlock(const Eigen::Matrix3d& R_cam_imu, const std::string& camera_frame,
-                    const std::string& imu_frame) {
+std::string tfBlock(const Eigen::Matrix3d& R_cam_imu, const ExportTranslation& t,
+                    const std::string& camera_frame, const std::string& imu_frame) {
   const Eigen::Quaterniond q = canonicalQuaternion(R_cam_imu);
+  const Eigen::Vector3d& p = t.p_cam_imu_m;
+  const std::string xyz =
+      t.measured ? exact(p(0)) + " " + exact(p(1)) + " " + exact(p(2)) : std::string("0 0 0");
   return "# tf2: parent = camera frame, child = IMU frame (maps IMU-frame points into the camera "
-         "frame):\n"
-         "rosrun tf2_ros static_transform_publisher 0 0 0 " +
+         "frame);\n" +
+         translationComment(t) + "rosrun tf2_ros static_transform_publisher " + xyz + " " +
          exact(q.x()) + " " + exact(q.y()) + " " + exact(q.z()) + " " + exact(q.w()) + " " +
          frameOr(camera_frame, kDefaultCameraFrame) + " " + frameOr(imu_frame, kDefaultImuFrame) +
          "\n";
@@ -93,6 +118,14 @@ void writeEstimate(std::ostream& out, const ReportInput& in) {
   out << "  matrix:\n";
   for (int i = 0; i < 3; ++i) out << "    " << fixedList(R.row(i).transpose(), 9) << "\n";
   out << "  " << rollPitchYawText(R, 4) << "\n";
+  const ExportTranslation t = exportTranslationOf(in.result);
+  if (t.measured) {
+    out << "translation p_cam_imu (the IMU's position in the camera frame, m): "
+        << fixedList(t.p_cam_imu_m, 4) << " +- " << fixedList(t.sigma_m, 4)
+        << " (1-sigma; measured during motion)\n";
+  } else {
+    out << "translation: " << t.not_measured_reason << "\n";
+  }
 }
 
 /// The joint estimate: consistency, which IMU errors the data determined, what to rotate.
@@ -220,10 +253,22 @@ void writePoseFigures(std::ostream& out, const ReportFigures& figures) {
 
 }  // namespace
 
+ExportTranslation exportTranslationOf(const AlignmentResult& result) {
+  ExportTranslation t;
+  t.not_measured_reason = translationNotMeasuredReason(result);
+  t.measured = t.not_measured_reason.empty();
+  if (t.measured) {
+    t.p_cam_imu_m = result.joint->p_cam_imu_m;
+    t.sigma_m = result.joint->p_cam_imu_sigma_m;
+  }
+  return t;
+}
+
 std::string exportBlocks(const Eigen::Matrix3d& R_cam_imu, const std::string& camera_frame,
-                         const std::string& imu_frame, std::optional<double> timeshift_cam_imu_s) {
-  return kalibrBlock(R_cam_imu, timeshift_cam_imu_s) + "\n" + openVinsBlock(R_cam_imu) + "\n" +
-         vinsBlock(R_cam_imu) + "\n" + tfBlock(R_cam_imu, camera_frame, imu_frame);
+                         const std::string& imu_frame, std::optional<double> timeshift_cam_imu_s,
+                         const ExportTranslation& t) {
+  return kalibrBlock(R_cam_imu, t, timeshift_cam_imu_s) + "\n" + openVinsBlock(R_cam_imu, t) +
+         "\n" + vinsBlock(R_cam_imu, t) + "\n" + tfBlock(R_cam_imu, t, camera_frame, imu_frame);
 }
 
 std::string formatSummary(const ReportInput& input) {
@@ -248,7 +293,8 @@ std::string formatSummary(const ReportInput& input) {
   out << exportBlocks(input.result.R_cam_imu, input.camera_frame, input.imu_frame,
                       joint && joint->ok && joint->timeshift_estimated
                           ? std::optional<double>(joint->timeshift_cam_imu_s)
-                          : std::nullopt);
+                          : std::nullopt,
+                      exportTranslationOf(input.result));
   return out.str();
 }
 

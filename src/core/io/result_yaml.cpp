@@ -57,6 +57,30 @@ void writeRotation(std::ostream& out, const std::string& name, const std::string
 
 }  // namespace
 
+std::string translationNotMeasuredReason(const AlignmentResult& r) {
+  const char* keep = ": keep your measured translation";
+  if (!r.joint || !r.joint->ok) return std::string("not measured (no joint estimate)") + keep;
+  const JointResult& j = *r.joint;
+  if (j.lever_arm_measured) return "";
+  if (j.motion_nodes == 0) {
+    return std::string(
+               "not measured: rests only (the lever arm needs the camera's positions "
+               "during motion)") +
+           keep;
+  }
+  if (!j.lever_arm_in_model) {
+    return std::string(
+               "not measured: no camera positions during the motion (or "
+               "motion_accel_link_s 0)") +
+           keep;
+  }
+  std::ostringstream out;
+  out << std::setprecision(2) << "not determined by the motion (1-sigma " << j.p_cam_imu_sigma_m(0)
+      << ", " << j.p_cam_imu_sigma_m(1) << ", " << j.p_cam_imu_sigma_m(2) << " m, near its prior)"
+      << keep;
+  return out.str();
+}
+
 std::string resultToYaml(const AlignmentResult& r, const ResultMetadata& meta) {
   const Eigen::Matrix3d& R = r.R_cam_imu;
   const SolutionQuality& q = r.quality;
@@ -65,12 +89,26 @@ std::string resultToYaml(const AlignmentResult& r, const ResultMetadata& meta) {
   out << "camera_frame: " << quoted(meta.camera_frame) << "  # the camera's tf frame\n";
   out << "imu_frame: " << quoted(meta.imu_frame) << "  # the IMU's tf frame\n";
   writeRotation(out, "R_cam_imu", "p_cam = R_cam_imu * p_imu", R);
-  out << "T_cam_imu:  # Kalibr camchain-imucam convention, translation zero\n";
+  // The translation where the motion measured it (the translation block says whether).
+  const bool measured = r.joint && r.joint->ok && r.joint->lever_arm_measured;
+  const Eigen::Vector3d t = measured ? r.joint->p_cam_imu_m : Eigen::Vector3d::Zero();
+  out << "T_cam_imu:  # Kalibr camchain-imucam convention; translation: see the translation "
+         "block\n";
   for (int i = 0; i < 3; ++i) {
-    out << "  - [" << std::setprecision(9) << R(i, 0) << ", " << R(i, 1) << ", " << R(i, 2)
-        << ", 0.0]\n";
+    out << "  - [" << std::setprecision(9) << R(i, 0) << ", " << R(i, 1) << ", " << R(i, 2) << ", "
+        << (measured ? t(i) : 0.0) << "]\n";
   }
   out << "  - [0.0, 0.0, 0.0, 1.0]\n" << std::setprecision(6);
+  out << "translation:  # T_cam_imu's: the IMU's position in the camera frame (m)\n";
+  out << "  measured: " << (measured ? "true" : "false") << "\n";
+  if (measured) {
+    out << std::setprecision(9) << "  p_cam_imu_m: " << row(t) << "\n"
+        << "  sigma_m: " << row(r.joint->p_cam_imu_sigma_m) << "  # 1-sigma per camera axis\n"
+        << std::setprecision(6)
+        << "  source: \"the accelerometer during motion against the camera's positions\"\n";
+  } else {
+    out << "  source: " << quoted(translationNotMeasuredReason(r)) << "\n";
+  }
   if (r.joint && r.joint->ok && r.joint->timeshift_estimated) {
     out << std::setprecision(9) << "timeshift_cam_imu_s: " << r.joint->timeshift_cam_imu_s
         << "  # Kalibr's timeshift_cam_imu: t_imu = t_cam + timeshift_cam_imu_s\n"
