@@ -360,20 +360,6 @@ TEST(ResultYaml, FailedWritesThrowAndLeaveNoTrace) {
   EXPECT_EQ(entries(), entries_before);
 }
 
-/// Runs `body` as the unprivileged user nobody in a child process when we are root (root ignores
-/// directory permissions), else directly. True when `body` returned true.
-bool asUnprivilegedUser(const std::function<bool()>& body) {
-  if (geteuid() != 0) return body();
-  const pid_t child = fork();
-  if (child == 0) {
-    const bool ok = setgid(65534) == 0 && setuid(65534) == 0 && body();
-    _exit(ok ? 0 : 1);
-  }
-  int status = 0;
-  return child > 0 && waitpid(child, &status, 0) == child && WIFEXITED(status) &&
-         WEXITSTATUS(status) == 0;
-}
-
 TEST(ResultYaml, ReadOnlyDirectoryKeepsThePreviousFile) {
   // A directory the writer may read but not write, reachable by everyone (not under the 0700
   // per-process temp dir, so that the unprivileged child gets as far as the write).
@@ -385,7 +371,7 @@ TEST(ResultYaml, ReadOnlyDirectoryKeepsThePreviousFile) {
   writeResultYaml(path, knownResult(before), ResultMetadata{});
   ASSERT_EQ(chmod(path.c_str(), 0644), 0);
   ASSERT_EQ(chmod(dir.c_str(), 0555), 0);
-  const bool refused = asUnprivilegedUser([&] {
+  const bool refused = test::asUnprivilegedUser([&] {
     try {
       writeResultYaml(path, knownResult(Eigen::Matrix3d::Identity()), ResultMetadata{});
     } catch (const InputError& e) {

@@ -315,12 +315,12 @@ int main(int argc, char** argv) {
     return 0;
   } catch (const cia::UsageError& e) {
     std::cerr << "simulate_bag: " << e.what() << "\n" << usage();
-    return 2;
+    return cia::kExitBadInput;
   } catch (const cia::SettingsError& e) {
     std::cerr << "simulate_bag: " << e.what() << "\n" << usage();
-    return 2;
+    return cia::kExitBadInput;
   } catch (const std::exception& e) {
     std::cerr << "simulate_bag: " << e.what() << "\n";
-    return 2;
+    return cia::kExitBadInput;
   }
 }

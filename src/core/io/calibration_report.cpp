@@ -10,6 +10,8 @@
 #include <sstream>
 #include <vector>
 
+#include "camera_imu_alignment/io/atomic_file.h"
+#include "camera_imu_alignment/io/input_error.h"
 #include "camera_imu_alignment/io/joint_yaml.h"
 #include "camera_imu_alignment/io/report_figures.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
@@ -392,9 +394,20 @@ bool writeReportPng(const std::string& path, const ReportInput& input, std::stri
   if (!parent.empty() && !std::filesystem::is_directory(parent, ec)) {
     return fail("directory '" + parent.string() + "' does not exist");
   }
+  // Encoded in memory (the format from the extension, as cv::imwrite), then written atomically.
+  std::string extension = std::filesystem::path(path).extension().string();
+  if (extension.empty()) extension = ".png";
+  std::vector<unsigned char> encoded;
   try {
-    if (!cv::imwrite(path, renderReport(input))) return fail("cv::imwrite failed");
+    if (!cv::imencode(extension, renderReport(input), encoded)) {
+      return fail("cv::imencode failed for '" + extension + "'");
+    }
   } catch (const cv::Exception& e) {
+    return fail(e.what());
+  }
+  try {
+    writeFileAtomically(path, std::string(encoded.begin(), encoded.end()));
+  } catch (const InputError& e) {
     return fail(e.what());
   }
   return true;

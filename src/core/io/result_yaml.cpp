@@ -11,6 +11,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "camera_imu_alignment/io/atomic_file.h"
 #include "camera_imu_alignment/io/csv_io.h"
 #include "camera_imu_alignment/io/joint_yaml.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
@@ -117,30 +118,8 @@ std::string resultToYaml(const AlignmentResult& r, const ResultMetadata& meta) {
 
 void writeResultYaml(const std::string& path, const AlignmentResult& result,
                      const ResultMetadata& meta) {
-  // Written to a temporary file and renamed over the old one: a failed write (disk full, no
-  // permission) leaves the previous calibration as it was.
-  const std::string tmp = path + ".tmp";
-  const auto reason = [] { return std::string(" (") + std::strerror(errno) + ")"; };
-  {
-    errno = 0;
-    std::ofstream out(tmp);
-    if (!out) {
-      throw InputError(path + ": cannot write the temporary file " + tmp + reason() +
-                       "; the previous file is unchanged");
-    }
-    out << resultToYaml(result, meta);
-    out.flush();
-    if (!out) {
-      const std::string why = reason();
-      std::remove(tmp.c_str());
-      throw InputError(path + ": write error" + why + "; the previous file is unchanged");
-    }
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string why = reason();
-    std::remove(tmp.c_str());
-    throw InputError(path + ": cannot replace the file" + why + "; the previous file is unchanged");
-  }
+  // A failed write (disk full, no permission) leaves the previous calibration as it was.
+  writeFileAtomically(path, resultToYaml(result, meta));
 }
 
 StoredCalibration readResultYaml(const std::string& path) {
