@@ -434,6 +434,37 @@ TEST(ResultYaml, FullDiskKeepsThePreviousFile) {
   EXPECT_FALSE(std::filesystem::exists(std::filesystem::symlink_status(path + ".tmp")));
 }
 
+TEST(ResultYaml, TheVerdictBlockIsWrittenReadAndAFailedOneIsNoted) {
+  const Eigen::Matrix3d X = test::axisAngle(kX, 0.2);
+  ResultMetadata meta;
+  const std::string plain = tempDir() + "no_verdict.yaml";
+  writeResultYaml(plain, knownResult(X), meta);  // solve_rotation: no gates, no block
+  EXPECT_FALSE(readResultYaml(plain).verdict);
+  EXPECT_EQ(failedVerdictNote(readResultYaml(plain), plain), "");
+  meta.verdict = ResultVerdict{false, "FAILED: joint estimate inconsistent \"chi2\"", true};
+  const std::string forced = tempDir() + "forced.yaml";
+  writeResultYaml(forced, knownResult(X), meta);
+  const StoredCalibration stored = readResultYaml(forced);
+  ASSERT_TRUE(stored.verdict);
+  EXPECT_FALSE(stored.verdict->passed);
+  EXPECT_TRUE(stored.verdict->forced);
+  EXPECT_EQ(stored.verdict->text, "FAILED: joint estimate inconsistent \"chi2\"");
+  EXPECT_ROTATION_NEAR_DEG(stored.R_cam_imu, X, 1e-9);  // the rotation reads as before
+  EXPECT_EQ(failedVerdictNote(stored, forced),
+            forced +
+                " holds an estimate that FAILED its quality gates, written on request "
+                "(force): joint estimate inconsistent \"chi2\"");
+  // A block without its verdict is an error naming the key, not a silent pass.
+  const std::string text = "R_cam_imu:\n  quaternion_xyzw: [0, 0, 0, 1]\nverdict: FAILED\n";
+  try {
+    readResultYaml(writeTemp("bad_verdict.yaml", text));
+    ADD_FAILURE() << "a verdict without passed was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("verdict needs the key passed"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(ResultYaml, CorruptSavedFileIsSetAsideAndTheNodeStartsFresh) {
   std::string warning;
   EXPECT_FALSE(loadSavedCalibration(tempDir() + "never_saved.yaml", &warning));

@@ -60,6 +60,13 @@ std::string resultToYaml(const AlignmentResult& r, const ResultMetadata& meta) {
   out << std::setprecision(6);
   out << "camera_frame: " << quoted(meta.camera_frame) << "  # the camera's tf frame\n";
   out << "imu_frame: " << quoted(meta.imu_frame) << "  # the IMU's tf frame\n";
+  if (meta.verdict) {
+    out << "verdict:  # the quality gates' verdict it was written under\n";
+    out << "  passed: " << (meta.verdict->passed ? "true" : "false") << "\n";
+    out << "  forced: " << (meta.verdict->forced ? "true" : "false")
+        << "  # written on request (calibrate_bag --force, ~calibrate force) although it failed\n";
+    out << "  text: " << quoted(meta.verdict->text) << "\n";
+  }
   writeRotation(out, "R_cam_imu", "p_cam = R_cam_imu * p_imu", R);
   out << "T_cam_imu:  # Kalibr camchain-imucam convention, translation zero\n";
   for (int i = 0; i < 3; ++i) {
@@ -168,10 +175,30 @@ StoredCalibration readResultYaml(const std::string& path) {
       }
     }
     if (quality && quality["num_poses"]) stored.num_poses = quality["num_poses"].as<int>();
+    const YAML::Node verdict = root["verdict"];
+    if (verdict) {
+      if (!verdict.IsMap() || !verdict["passed"]) {
+        throw InputError(path + ": verdict needs the key passed (true or false)");
+      }
+      ResultVerdict v;
+      v.passed = verdict["passed"].as<bool>();
+      if (verdict["forced"]) v.forced = verdict["forced"].as<bool>();
+      if (verdict["text"]) v.text = verdict["text"].as<std::string>();
+      stored.verdict = v;
+    }
   } catch (const YAML::Exception& e) {
     throw InputError(path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }
   return stored;
+}
+
+std::string failedVerdictNote(const StoredCalibration& stored, const std::string& path) {
+  if (!stored.verdict || stored.verdict->passed) return "";
+  std::string why = stored.verdict->text;
+  if (why.rfind("FAILED: ", 0) == 0) why.erase(0, 8);
+  return path + " holds an estimate that FAILED its quality gates" +
+         (stored.verdict->forced ? std::string(", written on request (force)") : std::string()) +
+         (why.empty() ? std::string() : ": " + why);
 }
 
 std::optional<StoredCalibration> loadSavedCalibration(const std::string& path,
