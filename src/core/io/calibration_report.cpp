@@ -327,13 +327,17 @@ void drawEstimateText(cv::Mat& img, const cv::Rect& panel, const ReportInput& in
     }
   }
   for (const std::string& text : wrapText(r.message, width, 0.5, 2)) line(text, kBlack);
-  line("q_cam_imu (x, y, z, w): [" + fixed(quat.x(), 6) + ", " + fixed(quat.y(), 6) + ", " +
-           fixed(quat.z(), 6) + ", " + fixed(quat.w(), 6) + "]   (p_cam = R_cam_imu * p_imu, " +
-           in.camera_frame + " <- " + in.imu_frame + ")",
-       kBlack);
-  line("roll, pitch, yaw (deg, R = Rz Ry Rx): " + fixedList(rollPitchYawDeg(r.R_cam_imu), 3),
-       kBlack);
-  line("1-sigma about camera x, y, z (deg): " + fixedList(q.std_dev_deg, 4), kBlack);
+  if (!hasEstimate(r)) {  // nothing solved: no rotation is drawn (its placeholder is no answer)
+    line("R_cam_imu: no estimate", kRed);
+  } else {
+    line("q_cam_imu (x, y, z, w): [" + fixed(quat.x(), 6) + ", " + fixed(quat.y(), 6) + ", " +
+             fixed(quat.z(), 6) + ", " + fixed(quat.w(), 6) + "]   (p_cam = R_cam_imu * p_imu, " +
+             in.camera_frame + " <- " + in.imu_frame + ")",
+         kBlack);
+    line("roll, pitch, yaw (deg, R = Rz Ry Rx): " + fixedList(rollPitchYawDeg(r.R_cam_imu), 3),
+         kBlack);
+    line("1-sigma about camera x, y, z (deg): " + fixedList(q.std_dev_deg, 4), kBlack);
+  }
   if (figures.truth_error) {
     const double worst = figures.truth_error->largestErrorInSigmas();
     const cv::Scalar colour = std::isfinite(worst) && worst <= 3.0 ? kBlack : kRed;
