@@ -289,6 +289,49 @@ TEST(FormatSummary, NanFieldsPrintNa) {
   EXPECT_NE(text.find("status: bad input"), std::string::npos) << text;
 }
 
+/// A recording whose poses were read but gave no estimate (status bad input: nothing solved; its
+/// R_cam_imu is a placeholder), with that placeholder set to `placeholder`.
+ReportInput noEstimate(const Eigen::Matrix3d& placeholder) {
+  std::mt19937_64 rng(31);
+  ReportInput in = realisticInput(rng, randomRotation(rng), 2, 0.002);
+  in.pairs.clear();
+  in.result = AlignmentResult{};
+  in.result.message = "no rotation pairs: 1 pose in the window";
+  in.result.R_cam_imu = placeholder;
+  in.truth = KnownTruth{randomRotation(rng), "truth.yaml"};
+  return in;
+}
+
+TEST(FormatSummary, NoEstimatePrintsNoRotationAndNoBlocks) {
+  // Before: the placeholder identity was printed as R_cam_imu, with blocks to paste and a
+  // static_transform_publisher line, for a recording that gave nothing.
+  const ReportInput in = noEstimate(Eigen::Matrix3d::Identity());
+  ASSERT_FALSE(hasEstimate(in.result));
+  const std::string text = formatSummary(in);
+  EXPECT_NE(text.find("\nR_cam_imu: no estimate\n"), std::string::npos) << text;
+  for (const char* absent :
+       {"quaternion xyzw", "roll, pitch, yaw", "T_cam_imu", "T_imu_cam", "extrinsicRotation",
+        "static_transform_publisher", "1-sigma about", "observable:", "mount [0.000"}) {
+    EXPECT_EQ(text.find(absent), std::string::npos) << absent << "\n" << text;
+  }
+  EXPECT_NE(text.find("truth (truth.yaml): error n/a deg"), std::string::npos) << text;
+  EXPECT_NE(text.find("poses used: 2"), std::string::npos) << text;
+  EXPECT_NE(text.find("# no estimate: no blocks for other tools"), std::string::npos) << text;
+  // Whatever the placeholder, the text is the same: nothing in it comes from a rotation.
+  EXPECT_EQ(formatSummary(noEstimate(axisAngle(Eigen::Vector3d::UnitZ(), 0.7))), text);
+}
+
+TEST(RenderReport, NoEstimateDrawsNoRotation) {
+  // The page of a run without an estimate does not depend on the placeholder rotation (before, it
+  // drew the placeholder's quaternion and angles, and the per-pose mounts against it).
+  const cv::Mat identity = renderReport(noEstimate(Eigen::Matrix3d::Identity()));
+  const cv::Mat turned = renderReport(noEstimate(axisAngle(Eigen::Vector3d::UnitZ(), 0.7)));
+  EXPECT_EQ(cv::norm(identity, turned, cv::NORM_INF), 0.0);
+  ReportInput solved = noEstimate(axisAngle(Eigen::Vector3d::UnitZ(), 0.7));
+  solved.result.status = SolveStatus::kNotObservable;  // a best guess is shown, as such
+  EXPECT_GT(cv::norm(renderReport(solved), turned, cv::NORM_INF), 0.0);
+}
+
 TEST(RenderReport, RealisticInputDrawsAPageWithOutliersInRed) {
   std::mt19937_64 rng(15);
   const Eigen::Matrix3d R_cam_imu = randomRotation(rng);

@@ -378,20 +378,6 @@ TEST(ResultYaml, FailedWritesThrowAndLeaveNoTrace) {
   EXPECT_EQ(entries(), entries_before);
 }
 
-/// Runs `body` as the unprivileged user nobody in a child process when we are root (root ignores
-/// directory permissions), else directly. True when `body` returned true.
-bool asUnprivilegedUser(const std::function<bool()>& body) {
-  if (geteuid() != 0) return body();
-  const pid_t child = fork();
-  if (child == 0) {
-    const bool ok = setgid(65534) == 0 && setuid(65534) == 0 && body();
-    _exit(ok ? 0 : 1);
-  }
-  int status = 0;
-  return child > 0 && waitpid(child, &status, 0) == child && WIFEXITED(status) &&
-         WEXITSTATUS(status) == 0;
-}
-
 TEST(ResultYaml, ReadOnlyDirectoryKeepsThePreviousFile) {
   // A directory the writer may read but not write, reachable by everyone (not under the 0700
   // per-process temp dir, so that the unprivileged child gets as far as the write).
@@ -403,7 +389,7 @@ TEST(ResultYaml, ReadOnlyDirectoryKeepsThePreviousFile) {
   writeResultYaml(path, knownResult(before), ResultMetadata{});
   ASSERT_EQ(chmod(path.c_str(), 0644), 0);
   ASSERT_EQ(chmod(dir.c_str(), 0555), 0);
-  const bool refused = asUnprivilegedUser([&] {
+  const bool refused = test::asUnprivilegedUser([&] {
     try {
       writeResultYaml(path, knownResult(Eigen::Matrix3d::Identity()), ResultMetadata{});
     } catch (const InputError& e) {
@@ -464,6 +450,37 @@ TEST(ResultYaml, FullDiskKeepsThePreviousFile) {
   }
   EXPECT_ROTATION_NEAR_DEG(readResultYaml(path).R_cam_imu, before, 1e-9);
   EXPECT_FALSE(std::filesystem::exists(std::filesystem::symlink_status(path + ".tmp")));
+}
+
+TEST(ResultYaml, TheVerdictBlockIsWrittenReadAndAFailedOneIsNoted) {
+  const Eigen::Matrix3d X = test::axisAngle(kX, 0.2);
+  ResultMetadata meta;
+  const std::string plain = tempDir() + "no_verdict.yaml";
+  writeResultYaml(plain, knownResult(X), meta);  // solve_rotation: no gates, no block
+  EXPECT_FALSE(readResultYaml(plain).verdict);
+  EXPECT_EQ(failedVerdictNote(readResultYaml(plain), plain), "");
+  meta.verdict = ResultVerdict{false, "FAILED: joint estimate inconsistent \"chi2\"", true};
+  const std::string forced = tempDir() + "forced.yaml";
+  writeResultYaml(forced, knownResult(X), meta);
+  const StoredCalibration stored = readResultYaml(forced);
+  ASSERT_TRUE(stored.verdict);
+  EXPECT_FALSE(stored.verdict->passed);
+  EXPECT_TRUE(stored.verdict->forced);
+  EXPECT_EQ(stored.verdict->text, "FAILED: joint estimate inconsistent \"chi2\"");
+  EXPECT_ROTATION_NEAR_DEG(stored.R_cam_imu, X, 1e-9);  // the rotation reads as before
+  EXPECT_EQ(failedVerdictNote(stored, forced),
+            forced +
+                " holds an estimate that FAILED its quality gates, written on request "
+                "(force): joint estimate inconsistent \"chi2\"");
+  // A block without its verdict is an error naming the key, not a silent pass.
+  const std::string text = "R_cam_imu:\n  quaternion_xyzw: [0, 0, 0, 1]\nverdict: FAILED\n";
+  try {
+    readResultYaml(writeTemp("bad_verdict.yaml", text));
+    ADD_FAILURE() << "a verdict without passed was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("verdict needs the key passed"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(ResultYaml, CorruptSavedFileIsSetAsideAndTheNodeStartsFresh) {

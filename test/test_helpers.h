@@ -1,16 +1,21 @@
 // Test helpers, the one home of what several tests need: random rotations, noise and rotation
 // comparisons, independent of the library's own example generator and rotation math (tests build
-// their truth themselves); the per-process temporary directory and text files. Running the tools:
+// their truth themselves); the per-process temporary directory and text files; running a check as
+// an unprivileged user. Running the tools:
 // tool_runner.h; simulated runs through the pipeline: pipeline_simulation.h.
 #pragma once
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <random>
 #include <string>
@@ -134,6 +139,30 @@ inline std::string writeTempFile(const std::string& name, const std::string& tex
   const std::string path = tempPath(name);
   std::ofstream(path, std::ios::binary) << text;
   return path;
+}
+
+/// Runs `body` as the unprivileged user nobody in a child process when we are root (root ignores
+/// directory permissions), else directly. True when `body` returned true.
+inline bool asUnprivilegedUser(const std::function<bool()>& body) {
+  if (geteuid() != 0) return body();
+  const pid_t child = fork();
+  if (child == 0) {
+    const bool ok = setgid(65534) == 0 && setuid(65534) == 0 && body();
+    _exit(ok ? 0 : 1);
+  }
+  int status = 0;
+  return child > 0 && waitpid(child, &status, 0) == child && WIFEXITED(status) &&
+         WEXITSTATUS(status) == 0;
+}
+
+/// A folder the unprivileged user (asUnprivilegedUser) may enter and read but not write, under
+/// /tmp (the per-process temporary folder is 0700: nobody could not reach it); removed by the
+/// caller (chmod 0755 first).
+inline std::string readOnlyFolder() {
+  char pattern[] = "/tmp/cia_read_only_XXXXXX";
+  if (!mkdtemp(pattern)) std::abort();
+  chmod(pattern, 0555);
+  return std::string(pattern) + "/";
 }
 
 #define EXPECT_ROTATION_NEAR_DEG(R1, R2, tol_deg) \

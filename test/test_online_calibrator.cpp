@@ -385,6 +385,9 @@ TEST(OnlineCalibrator, CalibrateNowSaysWhyNotAndForceBroadcasts) {
   ASSERT_TRUE(c.broadcast().has_value());
   EXPECT_TRUE(c.broadcast()->R_cam_imu.isApprox(forced.result.R_cam_imu));
   EXPECT_NE(c.stateMessage().find("force"), std::string::npos);
+  // The broadcast (and what the nodelet saves from it) says which gate it failed.
+  EXPECT_NE(c.broadcast()->forced_although.find("max_std_dev_deg"), std::string::npos)
+      << c.broadcast()->forced_although;
 }
 
 TEST(OnlineCalibrator, ManualCaptureWantsFramesOnlyWhileArmed) {

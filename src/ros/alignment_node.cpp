@@ -4,6 +4,7 @@
 
 #include <memory>
 
+#include "camera_imu_alignment/io/exit_codes.h"
 #include "camera_imu_alignment/ros/alignment_wrapper.h"
 
 int main(int argc, char** argv) {
@@ -16,7 +17,7 @@ int main(int argc, char** argv) {
     wrapper = std::make_unique<camera_imu_alignment::AlignmentWrapper>(nh, private_nh);
   } catch (const std::exception& e) {
     ROS_FATAL("%s: cannot start: %s", ros::this_node::getName().c_str(), e.what());
-    return 2;
+    return camera_imu_alignment::kExitBadInput;
   }
   ros::spin();
   return 0;

@@ -109,6 +109,10 @@ bool AlignmentWrapper::Impl::save(const BroadcastEstimate& estimate, std::string
   try {
     // The broadcast estimate with its own quality: the poses behind it, not the window's now.
     ResultMetadata meta{cameraFrame(), imuFrame(), estimate.poses};
+    // A forced estimate is saved marked FAILED: no reader takes it for a good one.
+    meta.verdict = estimate.forced_although.empty()
+                       ? ResultVerdict{true, "PASSED (broadcast by the nodelet)", false}
+                       : ResultVerdict{false, "FAILED: " + estimate.forced_although, true};
     backUpOutputOnce();
     writeResultYaml(settings.output_file, *estimate.result, meta);
     return true;
@@ -127,7 +131,11 @@ void AlignmentWrapper::Impl::loadSaved() {
   if (!stored) return;
   saved_camera_frame = stored->camera_frame;
   saved_imu_frame = stored->imu_frame;
-  const BroadcastEstimate loaded = storedBroadcast(*stored, "loaded: " + settings.output_file);
+  const std::string failed = failedVerdictNote(*stored, settings.output_file);
+  if (!failed.empty()) ROS_WARN("%s: %s; broadcast as loaded", name.c_str(), failed.c_str());
+  const BroadcastEstimate loaded =
+      storedBroadcast(*stored, "loaded: " + settings.output_file +
+                                   (failed.empty() ? "" : " (FAILED its quality gates, forced)"));
   calibrator->loadBroadcast(loaded);
   ROS_INFO("%s: calibration loaded from %s (%d poses, 1-sigma %s deg)", name.c_str(),
            settings.output_file.c_str(), loaded.poses,

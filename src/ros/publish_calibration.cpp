@@ -14,6 +14,7 @@
 
 #include "camera_imu_alignment/config/settings_error.h"
 #include "camera_imu_alignment/io/default_frames.h"
+#include "camera_imu_alignment/io/exit_codes.h"
 #include "camera_imu_alignment/io/input_error.h"
 #include "camera_imu_alignment/io/result_yaml.h"
 #include "camera_imu_alignment/ros/message_conversion.h"
@@ -38,8 +39,10 @@ int main(int argc, char** argv) {
     stored = cia::readResultYaml(cia::expandHome(file));
   } catch (const std::exception& e) {
     ROS_FATAL("%s: cannot start: %s", name.c_str(), e.what());
-    return 2;
+    return cia::kExitBadInput;
   }
+  const std::string failed = cia::failedVerdictNote(stored, file);
+  if (!failed.empty()) ROS_WARN("%s: %s; broadcast as it is", name.c_str(), failed.c_str());
   if (camera_frame.empty())
     camera_frame = cia::frameOr(stored.camera_frame, cia::kDefaultCameraFrame);
   if (imu_frame.empty()) imu_frame = cia::frameOr(stored.imu_frame, cia::kDefaultImuFrame);

@@ -2,6 +2,7 @@
 #include "bag_reader.h"
 
 #include <geometry_msgs/PoseStamped.h>
+#include <rosbag/exceptions.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/CompressedImage.h>
@@ -127,6 +128,18 @@ bool readBagWindow(const CliArgs& args, BagRunInfo* info) {
   std::cerr << "[calibrate_bag] reading " << from_s << " s to " << info->end_s - begin_s
             << " s of the bag (" << duration_s << " s)\n";
   return true;
+}
+
+std::string bagErrorMessage(const std::string& path, const std::exception& e) {
+  const std::string what = e.what();
+  const bool cut_short = dynamic_cast<const rosbag::BagUnindexedException*>(&e) != nullptr ||
+                         what.find("Error reading from file") != std::string::npos ||
+                         what.find("unindexed") != std::string::npos;
+  if (!cut_short) return path + ": " + what;
+  return path + ": cannot read the bag (" + what +
+         "): it is truncated or was not closed (a recording cut short has no index at its end); "
+         "rebuild the index with 'rosbag reindex " +
+         path + "' (it keeps the original beside it) and run again";
 }
 
 void readBag(const rosbag::Bag& bag, const BagTopics& topics, OnlineCalibrator* calibrator,

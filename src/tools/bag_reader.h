@@ -6,6 +6,7 @@
 #include <rosbag/bag.h>
 
 #include <cstdint>
+#include <exception>
 #include <map>
 #include <string>
 
@@ -59,6 +60,12 @@ struct BagRunInfo {
 /// (start_s and end_s set to the bag's span). False after printing why on stderr (naming the
 /// option and the bag's duration) when a value is not a number or the window is empty.
 bool readBagWindow(const CliArgs& args, BagRunInfo* info);
+
+/// The message for a bag that rosbag could not open or read to the end (`e`, rosbag's exception),
+/// naming `path`. A bag cut short or never closed (rosbag's "Error reading from file", "Bag
+/// unindexed": the index at the end of the file is missing) is said so, with the command that
+/// rebuilds the index: `rosbag reindex <path>`.
+std::string bagErrorMessage(const std::string& path, const std::exception& e);
 
 /// Feeds every message of the selected topics to `calibrator` in bag order, then finish()es it.
 /// Throws rosbag exceptions on a corrupt or truncated bag.

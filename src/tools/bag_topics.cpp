@@ -2,6 +2,7 @@
 
 #include <rosbag/view.h>
 
+#include <algorithm>
 #include <map>
 #include <stdexcept>
 #include <vector>
@@ -27,6 +28,22 @@ std::string list(const std::vector<std::string>& topics) {
   return out;
 }
 
+/// The bag's topics of `wanted_types`, for a message about a topic that is not one of them:
+/// "the bag's sensor_msgs/Imu topics: /imu0, /imu1", or that it has none.
+std::string topicsOfTypes(const std::map<std::string, std::string>& types,
+                          const std::vector<std::string>& wanted_types) {
+  std::vector<std::string> found;
+  for (const auto& [topic, type] : types) {
+    if (std::find(wanted_types.begin(), wanted_types.end(), type) != wanted_types.end()) {
+      found.push_back(topic + (wanted_types.size() > 1 ? " (" + type + ")" : ""));
+    }
+  }
+  std::string kinds;
+  for (const auto& t : wanted_types) kinds += (kinds.empty() ? "" : " or ") + t;
+  if (found.empty()) return "the bag has no " + kinds + " topic";
+  return "the bag's " + kinds + " topics: " + list(found);
+}
+
 /// The topic of `type`: the requested one (checked) or the only one in the bag.
 std::string pick(const std::map<std::string, std::string>& types, const std::string& requested,
                  const std::vector<std::string>& wanted_types, const char* what, bool required,
@@ -39,13 +56,14 @@ std::string pick(const std::map<std::string, std::string>& types, const std::str
     }
     if (it == types.end()) {
       throw std::runtime_error(std::string(option) + " " + requested +
-                               ": no such topic in the bag");
+                               ": no such topic in the bag; " + topicsOfTypes(types, wanted_types));
     }
     for (const auto& t : wanted_types) {
       if (it->second == t) return it->first;
     }
     throw std::runtime_error(std::string(option) + " " + requested + ": topic has type " +
-                             it->second + ", " + what + " needs " + list(wanted_types));
+                             it->second + ", " + what + " needs " + list(wanted_types) + "; " +
+                             topicsOfTypes(types, wanted_types));
   }
   std::vector<std::string> candidates;
   for (const auto& [topic, type] : types) {

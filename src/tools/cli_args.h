@@ -1,5 +1,6 @@
 // Minimal "--name value" / "--flag" command-line parsing for the tools, with checked numbers.
-// Every problem throws UsageError; tools print it with their usage and exit 2.
+// Every problem throws UsageError; tools print it with their usage and exit 2 (kExitBadInput,
+// io/exit_codes.h).
 #pragma once
 
 #include <map>
@@ -7,15 +8,9 @@
 #include <stdexcept>
 #include <string>
 
-namespace camera_imu_alignment {
+#include "camera_imu_alignment/io/exit_codes.h"  // the tools' exit codes
 
-/// Exit codes of the tools (doc/CONVENTIONS.md).
-constexpr int kExitOk = 0;
-constexpr int kExitBadInput = 2;              ///< bad input or usage; the message names the culprit
-constexpr int kExitNotEnoughInformation = 3;  ///< not observable, or the two-step did not fit
-/// The estimate exists but fails the nodelet's quality gates (inconsistent data, 1-sigma too
-/// large) or the mount changed during the recording: calibrate_bag prints it, does not write it.
-constexpr int kExitQualityGate = 4;
+namespace camera_imu_alignment {
 
 class UsageError : public std::runtime_error {
  public:

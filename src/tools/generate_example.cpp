@@ -72,9 +72,9 @@ int main(int argc, char** argv) {
     return 0;
   } catch (const cia::UsageError& e) {
     std::cerr << "generate_example: " << e.what() << "\n" << kUsage;
-    return 2;
+    return cia::kExitBadInput;
   } catch (const std::exception& e) {
     std::cerr << "generate_example: " << e.what() << "\n";
-    return 2;
+    return cia::kExitBadInput;
   }
 }

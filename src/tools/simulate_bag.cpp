@@ -122,6 +122,29 @@ tf2_msgs::TFMessage magnetometerTf(const sim::SimulationConfig& c, const BagOpti
   return msg;
 }
 
+/// A mono8 image as its message (header not set); `empty`: no pixels, `rgb`: the same pixels as
+/// rgb8 (both injected bad inputs).
+sensor_msgs::Image imageMessage(const cv::Mat& mono, bool empty, bool rgb) {
+  sensor_msgs::Image image;
+  image.encoding = "mono8";
+  if (empty) {
+    image.height = image.width = image.step = 0;
+  } else if (rgb) {
+    image.encoding = "rgb8";
+    image.height = mono.rows;
+    image.width = mono.cols;
+    image.step = 3 * mono.cols;
+    image.data.reserve(3 * mono.total());
+    for (size_t p = 0; p < mono.total(); ++p) image.data.insert(image.data.end(), 3, mono.data[p]);
+  } else {
+    image.height = mono.rows;
+    image.width = mono.cols;
+    image.step = mono.cols;
+    image.data.assign(mono.data, mono.data + mono.total());
+  }
+  return image;
+}
+
 /// Writes the bag, messages merged in stamp order; returns the number of rendered images.
 int writeBag(const sim::SimulationRun& run, const std::string& path, const BagOptions& options) {
   const sim::SimulationConfig& c = run.config;
@@ -243,25 +266,9 @@ int writeBag(const sim::SimulationRun& run, const std::string& path, const BagOp
     }
     const cv::Mat mono = sim::ImageRenderer::toMono8(grey, c.noise_scale * c.pixel_noise_sigma,
                                                      run.frameNoiseSeed(j));
-    sensor_msgs::Image image;
+    sensor_msgs::Image image =
+        imageMessage(mono, contains(bad.empty_images, j), contains(bad.wrong_encoding_images, j));
     setHeader(&image.header, &image_seq, stamp, c.camera_frame);
-    image.encoding = "mono8";
-    if (contains(bad.empty_images, j)) {
-      image.height = image.width = image.step = 0;
-    } else if (contains(bad.wrong_encoding_images, j)) {
-      image.encoding = "rgb8";
-      image.height = mono.rows;
-      image.width = mono.cols;
-      image.step = 3 * mono.cols;
-      image.data.reserve(3 * mono.total());
-      for (size_t p = 0; p < mono.total(); ++p)
-        image.data.insert(image.data.end(), 3, mono.data[p]);
-    } else {
-      image.height = mono.rows;
-      image.width = mono.cols;
-      image.step = mono.cols;
-      image.data.assign(mono.data, mono.data + mono.total());
-    }
     sensor_msgs::CameraInfo info = info_template;
     setHeader(&info.header, &info_seq, stamp, c.camera_frame);
     if (contains(bad.zero_k_camera_infos, j)) {
@@ -315,12 +322,12 @@ int main(int argc, char** argv) {
     return 0;
   } catch (const cia::UsageError& e) {
     std::cerr << "simulate_bag: " << e.what() << "\n" << usage();
-    return 2;
+    return cia::kExitBadInput;
   } catch (const cia::SettingsError& e) {
     std::cerr << "simulate_bag: " << e.what() << "\n" << usage();
-    return 2;
+    return cia::kExitBadInput;
   } catch (const std::exception& e) {
     std::cerr << "simulate_bag: " << e.what() << "\n";
-    return 2;
+    return cia::kExitBadInput;
   }
 }

@@ -111,10 +111,9 @@ std::vector<double> list3(const Eigen::Vector3d& v, double scale) {
 const double kUt = 1e-6;  // T per uT
 const double kDeg = kPi / 180.0;
 
-}  // namespace
-
-const std::vector<Key>& simulateBagOptionTable() {
-  static const std::vector<Key> table = {
+/// The presets (applied first, in this order) and the motion.
+std::vector<Key> presetAndMotionKeys() {
+  return {
       // Presets, applied first in this order.
       number<std::uint64_t>("--seed", CIA_MEMBER(config.seed), within(0, 9007199254740992.0), "",
                             "random seed: same seed and options, same bag"),
@@ -212,7 +211,12 @@ const std::vector<Key>& simulateBagOptionTable() {
             o->config.remount_rotvec_cam = vec3(v, kDeg);
           },
           "3 numbers x,y,z", "deg", "remount rotation vector (camera frame)"),
-      // Inertial/magnetic unit.
+  };
+}
+
+/// The inertial and magnetic unit, the target.
+std::vector<Key> inertialAndTargetKeys() {
+  return {
       number<double>("--imu-rate-hz", CIA_MEMBER(config.imu_rate_hz), within(1, 10000), "Hz",
                      "IMU sample rate"),
       number<double>("--mag-rate-hz", CIA_MEMBER(config.mag_rate_hz), within(1, 10000), "Hz",
@@ -296,7 +300,12 @@ const std::vector<Key>& simulateBagOptionTable() {
       flag(
           "--asymmetric-grid", [](Options* o) { o->config.target.asymmetric_grid = true; },
           "circlegrid: asymmetric"),
-      // Camera.
+  };
+}
+
+/// The camera, ROS names, time base and the bag.
+std::vector<Key> cameraAndBagKeys() {
+  return {
       number<int>("--width", CIA_MEMBER(config.width), within(16, 4096), "px", "image width"),
       number<int>("--height", CIA_MEMBER(config.height), within(16, 4096), "px", "image height"),
       number<double>("--fx", CIA_MEMBER(config.fx), within(1, 1e5), "px", "focal length x"),
@@ -365,6 +374,18 @@ const std::vector<Key>& simulateBagOptionTable() {
       wordKey<Options>("--compression", CIA_MEMBER(bag.compression), {"none", "lz4", "bz2"},
                        "bag compression"),
   };
+}
+
+}  // namespace
+
+const std::vector<Key>& simulateBagOptionTable() {
+  static const std::vector<Key> table = [] {
+    std::vector<Key> keys = presetAndMotionKeys();
+    for (auto part : {inertialAndTargetKeys(), cameraAndBagKeys()}) {
+      keys.insert(keys.end(), part.begin(), part.end());
+    }
+    return keys;
+  }();
   return table;
 }
 

@@ -23,7 +23,8 @@ inline constexpr int kReportWidthPx = 1200, kReportHeightPx = 1640;
 /// 1-sigma, and the rotation the motion carried about each camera axis.
 cv::Mat renderReport(const ReportInput& input);
 
-/// renderReport + cv::imwrite; false with `error` set when writing fails.
+/// renderReport encoded in the format of the path's extension (PNG without one) and written
+/// atomically (io/atomic_file.h); false with `error` set when writing fails.
 bool writeReportPng(const std::string& path, const ReportInput& input, std::string* error);
 
 }  // namespace camera_imu_alignment

@@ -51,7 +51,9 @@ struct ReportInput {
 /// x-y-z fixed-axis convention of tf: R = Rz(yaw) Ry(pitch) Rx(roll)), 1-sigma about the camera
 /// axes, RMS residual, observability (and the axis to rotate about when not observable), poses
 /// used / rejected with reasons, inputs rejected by reason, the figures per pose and the error to
-/// the truth when given (report_figures.h), then exportBlocks().
+/// the truth when given (report_figures.h), then exportBlocks(). Without an estimate
+/// (hasEstimate(): nothing was solved) it says "R_cam_imu: no estimate" and prints no rotation, no
+/// quality of one and no blocks.
 std::string formatSummary(const ReportInput& input);
 
 /// T_cam_imu's translation for the export blocks: the IMU's position in the camera frame (m) with

@@ -24,10 +24,12 @@ RotationPairs readPairsCsv(const std::string& path);
 /// InputError.
 std::vector<PoseOrientation> readPosesCsv(const std::string& path);
 
-/// Writes a pairs file (header + one row per pair).
+/// Writes a pairs file (header + one row per pair), atomically (io/atomic_file.h). Throws
+/// InputError.
 void writePairsCsv(const std::string& path, const RotationPairs& pairs);
 
-/// Writes a poses file (header + one row per pose; a group column when the poses have several).
+/// Writes a poses file (header + one row per pose; a group column when the poses have several),
+/// atomically (io/atomic_file.h). Throws InputError.
 void writePosesCsv(const std::string& path, const std::vector<PoseOrientation>& poses);
 
 }  // namespace camera_imu_alignment

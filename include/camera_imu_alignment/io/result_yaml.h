@@ -13,10 +13,21 @@
 
 namespace camera_imu_alignment {
 
+/// The quality gates' verdict a result was written under: the file's `verdict:` block. An estimate
+/// that failed them is written only on request (calibrate_bag --force, the nodelet's ~calibrate
+/// with force: true), and the block says so.
+struct ResultVerdict {
+  bool passed = true;
+  std::string text;     ///< "PASSED (...)" or "FAILED: <the gate, with its numbers>"
+  bool forced = false;  ///< written on request although it failed
+};
+
 struct ResultMetadata {
   std::string camera_frame = kDefaultCameraFrame;  ///< the tf frame of the camera
   std::string imu_frame = kDefaultImuFrame;        ///< the tf frame of the IMU
   int num_poses = 0;  ///< stationary poses behind the pairs (0: pairs given)
+  /// When set, the `verdict:` block (solve_rotation has no gates and writes none).
+  std::optional<ResultVerdict> verdict;
 };
 
 /// The result document as YAML text.
@@ -41,11 +52,19 @@ struct StoredCalibration {
   /// truth file does not).
   std::optional<Eigen::Vector3d> std_dev_deg;
   int num_poses = 0;
+  std::optional<ResultVerdict> verdict;  ///< the `verdict:` block when the file has one
 };
 
 /// Reads R_cam_imu (quaternion_xyzw, else matrix) from a result YAML. Throws InputError naming the
-/// file and the key on any problem (missing key, not finite, not a rotation).
+/// file and the key on any problem (missing key, not finite, not a rotation, a `verdict:` block
+/// without a boolean `passed`).
 StoredCalibration readResultYaml(const std::string& path);
+
+/// "" unless `stored` (read from `path`) was written under a FAILED verdict; then one line for its
+/// reader to show: the file holds an estimate that failed its quality gates (written on request),
+/// and the verdict. Every reader of a result file shows it: a FAILED estimate is never taken for a
+/// good one silently.
+std::string failedVerdictNote(const StoredCalibration& stored, const std::string& path);
 
 /// For a node starting up: the calibration saved at `path`, nullopt when there is no file. A file
 /// that cannot be read (corrupt, truncated, not a rotation) is renamed to `path + ".bad"`, kept for

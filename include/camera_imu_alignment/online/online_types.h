@@ -83,6 +83,9 @@ struct BroadcastEstimate {
   /// The best estimate that passed the gates, when estimated here: what is saved (its
   /// std_dev_deg, covariance and poses are the fields above).
   std::optional<AlignmentResult> result;
+  /// "" unless broadcast on request (~calibrate with force) although a gate failed: that gate's
+  /// why, saved as the file's FAILED verdict (result_yaml.h, ResultVerdict).
+  std::string forced_although;
   double maxStdDevDeg() const { return std_dev_deg.maxCoeff(); }
 };
 

@@ -62,6 +62,11 @@ struct AlignmentResult {
   std::vector<std::string> stage_notes;
 };
 
+/// Whether `result` holds a rotation at all (the outputs show none otherwise): any status but
+/// kBadInput, whose R_cam_imu is a placeholder (identity: no pairs, nothing solved), and finite.
+/// A kNotObservable or kPoorFit estimate is a best guess, shown as such.
+bool hasEstimate(const AlignmentResult& result);
+
 /// Solves A_j X = X B_j for X = R_cam_imu.
 AlignmentResult solveAlignment(const RotationPairs& pairs, const SolverOptions& options = {});
 

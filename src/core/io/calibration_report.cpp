@@ -10,6 +10,8 @@
 #include <sstream>
 #include <vector>
 
+#include "camera_imu_alignment/io/atomic_file.h"
+#include "camera_imu_alignment/io/input_error.h"
 #include "camera_imu_alignment/io/joint_yaml.h"
 #include "camera_imu_alignment/io/report_figures.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
@@ -325,13 +327,17 @@ void drawEstimateText(cv::Mat& img, const cv::Rect& panel, const ReportInput& in
     }
   }
   for (const std::string& text : wrapText(r.message, width, 0.5, 2)) line(text, kBlack);
-  line("q_cam_imu (x, y, z, w): [" + fixed(quat.x(), 6) + ", " + fixed(quat.y(), 6) + ", " +
-           fixed(quat.z(), 6) + ", " + fixed(quat.w(), 6) + "]   (p_cam = R_cam_imu * p_imu, " +
-           in.camera_frame + " <- " + in.imu_frame + ")",
-       kBlack);
-  line("roll, pitch, yaw (deg, R = Rz Ry Rx): " + fixedList(rollPitchYawDeg(r.R_cam_imu), 3),
-       kBlack);
-  line("1-sigma about camera x, y, z (deg): " + fixedList(q.std_dev_deg, 4), kBlack);
+  if (!hasEstimate(r)) {  // nothing solved: no rotation is drawn (its placeholder is no answer)
+    line("R_cam_imu: no estimate", kRed);
+  } else {
+    line("q_cam_imu (x, y, z, w): [" + fixed(quat.x(), 6) + ", " + fixed(quat.y(), 6) + ", " +
+             fixed(quat.z(), 6) + ", " + fixed(quat.w(), 6) + "]   (p_cam = R_cam_imu * p_imu, " +
+             in.camera_frame + " <- " + in.imu_frame + ")",
+         kBlack);
+    line("roll, pitch, yaw (deg, R = Rz Ry Rx): " + fixedList(rollPitchYawDeg(r.R_cam_imu), 3),
+         kBlack);
+    line("1-sigma about camera x, y, z (deg): " + fixedList(q.std_dev_deg, 4), kBlack);
+  }
   if (figures.truth_error) {
     const double worst = figures.truth_error->largestErrorInSigmas();
     const cv::Scalar colour = std::isfinite(worst) && worst <= 3.0 ? kBlack : kRed;
@@ -392,9 +398,20 @@ bool writeReportPng(const std::string& path, const ReportInput& input, std::stri
   if (!parent.empty() && !std::filesystem::is_directory(parent, ec)) {
     return fail("directory '" + parent.string() + "' does not exist");
   }
+  // Encoded in memory (the format from the extension, as cv::imwrite), then written atomically.
+  std::string extension = std::filesystem::path(path).extension().string();
+  if (extension.empty()) extension = ".png";
+  std::vector<unsigned char> encoded;
   try {
-    if (!cv::imwrite(path, renderReport(input))) return fail("cv::imwrite failed");
+    if (!cv::imencode(extension, renderReport(input), encoded)) {
+      return fail("cv::imencode failed for '" + extension + "'");
+    }
   } catch (const cv::Exception& e) {
+    return fail(e.what());
+  }
+  try {
+    writeFileAtomically(path, std::string(encoded.begin(), encoded.end()));
+  } catch (const InputError& e) {
     return fail(e.what());
   }
   return true;

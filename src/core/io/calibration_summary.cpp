@@ -279,11 +279,21 @@ std::string formatSummary(const ReportInput& input) {
   if (input.verdict) out << "verdict: " << input.verdict->text << "\n";
   if (!input.result.message.empty()) out << "message: " << input.result.message << "\n";
   const ReportFigures figures = reportFigures(input);
-  writeEstimate(out, input);
-  writeQuality(out, input);
+  const bool estimate = hasEstimate(input.result);
+  if (estimate) {
+    writeEstimate(out, input);
+    writeQuality(out, input);
+  } else {  // nothing solved: no rotation, no quality of one, nothing to paste
+    out << "R_cam_imu: no estimate\n";
+    if (input.result.joint) writeJoint(out, *input.result.joint);
+  }
   if (figures.truth_error) out << truthErrorText(*figures.truth_error) << "\n";
   writePoses(out, input);
   writePoseFigures(out, figures);
+  if (!estimate) {
+    out << "\n# no estimate: no blocks for other tools (Kalibr, OpenVINS, VINS, tf2)\n";
+    return out.str();
+  }
   out << "\n";
   if (input.result.status != SolveStatus::kOk) {
     out << "# WARNING: status '" << toString(input.result.status)

@@ -8,6 +8,8 @@
 #include <map>
 #include <sstream>
 
+#include "camera_imu_alignment/io/atomic_file.h"
+
 namespace camera_imu_alignment {
 namespace {
 
@@ -153,8 +155,7 @@ std::vector<PoseOrientation> readPosesCsv(const std::string& path) {
 }
 
 void writePairsCsv(const std::string& path, const RotationPairs& pairs) {
-  std::ofstream out(path);
-  if (!out) throw InputError(path + ": cannot write file");
+  std::ostringstream out;
   out.precision(17);
   out << "qa_w,qa_x,qa_y,qa_z,qb_w,qb_x,qb_y,qb_z\n";
   for (const auto& p : pairs) {
@@ -163,12 +164,11 @@ void writePairsCsv(const std::string& path, const RotationPairs& pairs) {
     writeQuaternion(out, p.B_imu);
     out << '\n';
   }
-  if (!out) throw InputError(path + ": write error");
+  writeFileAtomically(path, out.str());
 }
 
 void writePosesCsv(const std::string& path, const std::vector<PoseOrientation>& poses) {
-  std::ofstream out(path);
-  if (!out) throw InputError(path + ": cannot write file");
+  std::ostringstream out;
   out.precision(17);
   // The group column only when there is more than one group (poses of different groups are never
   // paired); files of a single group keep the plain header.
@@ -185,7 +185,7 @@ void writePosesCsv(const std::string& path, const std::vector<PoseOrientation>& 
     if (groups) out << ',' << p.group;
     out << '\n';
   }
-  if (!out) throw InputError(path + ": write error");
+  writeFileAtomically(path, out.str());
 }
 
 }  // namespace camera_imu_alignment

@@ -96,9 +96,12 @@ ReportFigures reportFigures(const ReportInput& in) {
   const std::size_t window = windowPoseCount(in);
   const std::size_t first = in.poses.size() - window;
   figures.window_poses = window;
-  const std::vector<double> pair_rms = pairResidualRmsDeg(in.pairs, X, window);
+  // No estimate (its rotation a placeholder): no residual or mount is measured against it.
+  const bool estimate = hasEstimate(in.result) && finiteRotation(X);
+  const std::vector<double> pair_rms =
+      estimate ? pairResidualRmsDeg(in.pairs, X, window) : std::vector<double>(window, kNaN);
   const std::map<int, Eigen::Matrix3d> R_target_world =
-      finiteRotation(X) ? targetInWorldByGroup(in, first, X) : std::map<int, Eigen::Matrix3d>{};
+      estimate ? targetInWorldByGroup(in, first, X) : std::map<int, Eigen::Matrix3d>{};
   const std::vector<double>* joint_residuals = nullptr;
   if (in.result.joint && in.result.joint->ok &&
       in.result.joint->pose_residual_norm.size() == window) {
@@ -130,8 +133,7 @@ ReportFigures reportFigures(const ReportInput& in) {
     e.angle_deg = kNaN;
     e.error_deg = Eigen::Vector3d::Constant(kNaN);
     // Bad input: no estimate to compare (its rotation is a placeholder): the error is n/a.
-    if (in.result.status != SolveStatus::kBadInput && finiteRotation(X) &&
-        finiteRotation(in.truth->R_cam_imu)) {
+    if (estimate && finiteRotation(in.truth->R_cam_imu)) {
       e.angle_deg = rad2deg(geodesicDistance(X, in.truth->R_cam_imu));
       e.error_deg = rad2deg(1.0) * logSO3(X * in.truth->R_cam_imu.transpose());
     }

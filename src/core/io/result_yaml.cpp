@@ -12,6 +12,7 @@
 #include <optional>
 #include <sstream>
 
+#include "camera_imu_alignment/io/atomic_file.h"
 #include "camera_imu_alignment/io/csv_io.h"
 #include "camera_imu_alignment/io/joint_yaml.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
@@ -88,6 +89,13 @@ std::string resultToYaml(const AlignmentResult& r, const ResultMetadata& meta) {
   out << std::setprecision(6);
   out << "camera_frame: " << quoted(meta.camera_frame) << "  # the camera's tf frame\n";
   out << "imu_frame: " << quoted(meta.imu_frame) << "  # the IMU's tf frame\n";
+  if (meta.verdict) {
+    out << "verdict:  # the quality gates' verdict it was written under\n";
+    out << "  passed: " << (meta.verdict->passed ? "true" : "false") << "\n";
+    out << "  forced: " << (meta.verdict->forced ? "true" : "false")
+        << "  # written on request (calibrate_bag --force, ~calibrate force) although it failed\n";
+    out << "  text: " << quoted(meta.verdict->text) << "\n";
+  }
   writeRotation(out, "R_cam_imu", "p_cam = R_cam_imu * p_imu", R);
   // The translation where the motion measured it (the translation block says whether).
   const bool measured = r.joint && r.joint->ok && r.joint->lever_arm_measured;
@@ -160,30 +168,8 @@ std::string resultToYaml(const AlignmentResult& r, const ResultMetadata& meta) {
 
 void writeResultYaml(const std::string& path, const AlignmentResult& result,
                      const ResultMetadata& meta) {
-  // Written to a temporary file and renamed over the old one: a failed write (disk full, no
-  // permission) leaves the previous calibration as it was.
-  const std::string tmp = path + ".tmp";
-  const auto reason = [] { return std::string(" (") + std::strerror(errno) + ")"; };
-  {
-    errno = 0;
-    std::ofstream out(tmp);
-    if (!out) {
-      throw InputError(path + ": cannot write the temporary file " + tmp + reason() +
-                       "; the previous file is unchanged");
-    }
-    out << resultToYaml(result, meta);
-    out.flush();
-    if (!out) {
-      const std::string why = reason();
-      std::remove(tmp.c_str());
-      throw InputError(path + ": write error" + why + "; the previous file is unchanged");
-    }
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string why = reason();
-    std::remove(tmp.c_str());
-    throw InputError(path + ": cannot replace the file" + why + "; the previous file is unchanged");
-  }
+  // A failed write (disk full, no permission) leaves the previous calibration as it was.
+  writeFileAtomically(path, resultToYaml(result, meta));
 }
 
 StoredCalibration readResultYaml(const std::string& path) {
@@ -247,10 +233,30 @@ StoredCalibration readResultYaml(const std::string& path) {
       }
     }
     if (quality && quality["num_poses"]) stored.num_poses = quality["num_poses"].as<int>();
+    const YAML::Node verdict = root["verdict"];
+    if (verdict) {
+      if (!verdict.IsMap() || !verdict["passed"]) {
+        throw InputError(path + ": verdict needs the key passed (true or false)");
+      }
+      ResultVerdict v;
+      v.passed = verdict["passed"].as<bool>();
+      if (verdict["forced"]) v.forced = verdict["forced"].as<bool>();
+      if (verdict["text"]) v.text = verdict["text"].as<std::string>();
+      stored.verdict = v;
+    }
   } catch (const YAML::Exception& e) {
     throw InputError(path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }
   return stored;
+}
+
+std::string failedVerdictNote(const StoredCalibration& stored, const std::string& path) {
+  if (!stored.verdict || stored.verdict->passed) return "";
+  std::string why = stored.verdict->text;
+  if (why.rfind("FAILED: ", 0) == 0) why.erase(0, 8);
+  return path + " holds an estimate that FAILED its quality gates" +
+         (stored.verdict->forced ? std::string(", written on request (force)") : std::string()) +
+         (why.empty() ? std::string() : ": " + why);
 }
 
 std::optional<StoredCalibration> loadSavedCalibration(const std::string& path,

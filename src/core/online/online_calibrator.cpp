@@ -117,7 +117,9 @@ struct OnlineCalibrator::Impl {
   /// The output as an estimate judged by the gates against what is broadcast now.
   EstimateEvent judged(SolveOutput output) const;
   void applyEstimate(EstimateEvent event);
-  void doBroadcast(const AlignmentResult& result, std::size_t poses);
+  /// `forced_although`: "" unless broadcast on request (force) although this gate failed.
+  void doBroadcast(const AlignmentResult& result, std::size_t poses,
+                   const std::string& forced_although = "");
   /// A more precise estimate within min_change_deg: the tf keeps its rotation, the saved file
   /// and the broadcast 1-sigma become the new estimate's (on_broadcast saves it).
   void refineBroadcast(const AlignmentResult& result, std::size_t poses);
@@ -361,8 +363,10 @@ void OnlineCalibrator::Impl::applyEstimate(EstimateEvent event) {
   });
 }
 
-void OnlineCalibrator::Impl::doBroadcast(const AlignmentResult& result, std::size_t poses) {
+void OnlineCalibrator::Impl::doBroadcast(const AlignmentResult& result, std::size_t poses,
+                                         const std::string& forced_although) {
   BroadcastEstimate b;
+  b.forced_although = forced_although;
   b.R_cam_imu = result.R_cam_imu;
   b.std_dev_deg = result.quality.std_dev_deg;
   if (result.joint && result.joint->ok) b.covariance_rad2 = result.joint->covariance_rad2;
@@ -385,6 +389,7 @@ void OnlineCalibrator::Impl::refineBroadcast(const AlignmentResult& result, std:
   b.poses = static_cast<int>(poses);
   b.source = "estimated";
   b.result = result;
+  b.forced_although.clear();  // this estimate passed the gates
   if (callbacks.on_broadcast) callbacks.on_broadcast(b);
 }
 
@@ -477,8 +482,14 @@ CalibrateOutcome OnlineCalibrator::calibrateNow(bool force) {
   if (forcible) {
     event.forced = true;
     impl_->last_estimate = event;
+    // Kept (good, not new enough to replace the tf) is no failure; rejected is, and the saved file
+    // says so.
+    const bool failed = event.gate.decision == GateDecision::kReject;
     impl_->applyThenReport(event, [&] {
-      impl_->doBroadcast(event.result, poses);
+      impl_->doBroadcast(event.result, poses,
+                         !failed                  ? std::string()
+                         : event.gate.why.empty() ? std::string("a quality gate failed")
+                                                  : event.gate.why);
       impl_->setState(CalibrationState::kCalibrated,
                       "broadcast on request (force) although: " + event.gate.why);
     });

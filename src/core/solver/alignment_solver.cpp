@@ -26,6 +26,10 @@ const char* toString(SolveStatus status) {
   return "unknown";
 }
 
+bool hasEstimate(const AlignmentResult& result) {
+  return result.status != SolveStatus::kBadInput && result.R_cam_imu.allFinite();
+}
+
 bool parseSolverMethod(const std::string& text, SolverMethod* method) {
   if (text == "optimal") {
     *method = SolverMethod::kOptimal;
