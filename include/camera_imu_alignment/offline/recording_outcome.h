@@ -111,8 +111,9 @@ std::string imuYamlText(const std::string& path, const ReportInput& report,
                         const std::string& imu_topic, double imu_rate_hz);
 
 /// Writes what `outcome` asks for, each file atomically: with the summary the report and the
-/// poses CSV, with write_result the result YAML (its verdict block) and the imu.yaml. One line per
-/// failure, naming the option and the path; empty when all were written.
+/// poses CSV, with write_result the result YAML (its verdict block) and the imu.yaml (under a
+/// FAILED verdict its first line a comment saying so: Kalibr's format has no such key). One line
+/// per failure, naming the option and the path; empty when all were written.
 std::vector<std::string> writeRecordingOutputs(const RecordingOutputPaths& paths,
                                                const RecordingOutcome& outcome,
                                                const RecordingProducts& products);
