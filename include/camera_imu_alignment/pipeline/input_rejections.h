@@ -22,7 +22,10 @@ enum class RejectReason {
   kBadCameraInfo,   ///< zero/non-finite K, D of a wrong length, unknown distortion model
   kTargetNotFound,  ///< no (or too little of the) target detected in a frame at rest
   kPoseRejected,    ///< PnP failed, reprojection error too high or ambiguous planar solution
-  kCount            ///< number of reasons (not a reason)
+  /// A camera frame of the other stream than the one whose first frame chose the camera source
+  /// (camera poses after images, or images after camera poses): one pipeline takes one
+  kMixedCameraSource,
+  kCount  ///< number of reasons (not a reason)
 };
 
 /// Which input a rejected item came from; the nodelet names the topic, calibrate_bag the bag topic.

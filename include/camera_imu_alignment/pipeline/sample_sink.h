@@ -19,8 +19,9 @@ struct CameraFrame {
   double stamp_s = 0.0;
   cv::Mat mono8;  ///< CV_8UC1; unused when R_target_cam is given
   /// The camera orientation when it comes from elsewhere (the user's own detector, motion capture:
-  /// the nodelet's camera_pose topic): then no image and no detection are needed. Use either
-  /// images or given orientations in one pipeline, not both (they share the stamp order).
+  /// the nodelet's camera_pose topic): then no image and no detection are needed. A pipeline takes
+  /// either images or given orientations: the first frame's kind, the other refused
+  /// (RejectReason::kMixedCameraSource).
   std::optional<Eigen::Matrix3d> R_target_cam;
   /// With R_target_cam: the camera's centre in the target frame (m), when given (camera_pose's
   /// position); the joint estimate's acceleration model uses it during motion.

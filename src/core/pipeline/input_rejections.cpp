@@ -39,6 +39,8 @@ const char* toString(RejectReason reason) {
       return "target_not_found";
     case RejectReason::kPoseRejected:
       return "pose_rejected";
+    case RejectReason::kMixedCameraSource:
+      return "mixed_camera_source";
     case RejectReason::kCount:
       break;
   }

@@ -1,6 +1,6 @@
 // CalibrationPipeline, pose side: a stationary segment ended -> IMU orientation (gyro chain /
-// accelerometer + magnetometer, rule in calibration_pipeline.h), camera orientation (robust
-// average of the frames at rest), pose window, solve.
+// accelerometer + magnetometer, rule in calibration_pipeline.h), camera orientation (the camera
+// source's assessment of the rest, camera_source.h), pose window, snapshot.
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -11,7 +11,6 @@
 #include "calibration_pipeline_impl.h"
 #include "camera_imu_alignment/estimation/camera_link_screening.h"
 #include "camera_imu_alignment/estimation/joint_estimator.h"
-#include "camera_imu_alignment/solver/rotation_average.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {
@@ -64,43 +63,6 @@ std::optional<Eigen::Matrix3d> messageOrientation(const std::deque<ImuSample>& s
   return Eigen::Quaterniond(sum(3), sum(0), sum(1), sum(2)).toRotationMatrix();
 }
 
-/// The board may look the same turned (TargetDetector::symmetries): among the readings
-/// S * R_target_cam, the right one turns the camera by the same angle as the IMU since the earlier
-/// poses of the group (a rotation angle does not depend on the frame). Keeps the detector's reading
-/// when no earlier pose can tell or the best two readings agree within `kSymmetryMarginDeg`.
-constexpr double kSymmetryMarginDeg = 2.0;
-constexpr std::size_t kSymmetryReferencePoses = 5;
-
-Eigen::Matrix3d resolveSymmetry(const Eigen::Matrix3d& R_target_cam,
-                                const Eigen::Matrix3d& R_world_imu, int group,
-                                const std::vector<StationaryPose>& poses,
-                                const std::vector<Eigen::Matrix3d>& symmetries) {
-  if (symmetries.empty()) return R_target_cam;
-  std::vector<const StationaryPose*> references;
-  for (auto it = poses.rbegin(); it != poses.rend(); ++it) {
-    if (it->group != group) break;  // groups are contiguous
-    references.push_back(&*it);
-    if (references.size() == kSymmetryReferencePoses) break;
-  }
-  if (references.empty()) return R_target_cam;
-  std::vector<Eigen::Matrix3d> readings{R_target_cam};
-  for (const auto& S : symmetries) readings.push_back(S * R_target_cam);
-  std::vector<double> cost(readings.size(), 0.0);
-  for (std::size_t k = 0; k < readings.size(); ++k) {
-    for (const StationaryPose* p : references) {
-      const double camera = rotationAngle(p->R_target_cam.transpose() * readings[k]);
-      const double imu = rotationAngle(p->R_world_imu.transpose() * R_world_imu);
-      cost[k] += std::abs(camera - imu) / static_cast<double>(references.size());
-    }
-  }
-  std::vector<std::size_t> order(readings.size());
-  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-  std::sort(order.begin(), order.end(),
-            [&](std::size_t a, std::size_t b) { return cost[a] < cost[b]; });
-  if (rad2deg(cost[order[1]] - cost[order[0]]) < kSymmetryMarginDeg) return R_target_cam;
-  return readings[order[0]];
-}
-
 /// Appends, dropping the oldest entry beyond CalibrationPipeline::kHistoryLimit.
 template <typename T>
 void pushBounded(std::vector<T>* history, const T& item) {
@@ -111,10 +73,10 @@ void pushBounded(std::vector<T>* history, const T& item) {
 }  // namespace
 
 void CalibrationPipeline::Impl::onSegment(const StationarySegment& segment) {
-  pushBounded(&segments, segment);
-  ++rests_total;
+  pushBounded(&records.segments, segment);
+  ++records.rests_total;
   StationaryPose pose;
-  pose.index = static_cast<int>(poses_total);
+  pose.index = static_cast<int>(records.poses_total);
   pose.start_s = segment.start_s;
   pose.end_s = segment.end_s;
   pose.gyro_bias_rad_s = segment.gyro_bias_rad_s;
@@ -122,13 +84,10 @@ void CalibrationPipeline::Impl::onSegment(const StationarySegment& segment) {
   integrateGyroSincePrevious(segment, &pose);
   StationaryWindow::Entry joint_entry = jointMeasurements(segment, pose, field);
   chooseImuOrientation(segment, &pose);
-  // Given camera poses (camera_pose) come with an orientation: no scene needed.
-  const std::string rejection = natural_scene && given_orientations == 0
-                                    ? assessScene(segment, &pose, &joint_entry)
-                                    : assessCamera(segment, &pose);
+  const std::string rejection = source->assessRest(segment, history(), &pose, &joint_entry);
   if (!rejection.empty()) {
     const RejectedPose rejected_pose{segment.start_s, segment.end_s, rejection};
-    pushBounded(&rejected, rejected_pose);
+    pushBounded(&records.rejected, rejected_pose);
     if (callbacks.on_pose_rejected) callbacks.on_pose_rejected(rejected_pose);
     return;
   }
@@ -141,7 +100,7 @@ StationaryWindow::Entry CalibrationPipeline::Impl::jointMeasurements(
   JointPose& jp = entry.joint;
   jp.start_s = segment.start_s;
   jp.end_s = segment.end_s;
-  const RestStatistics rest = restStatistics(imu_buffer, segment.start_s, segment.end_s);
+  const RestStatistics rest = restStatistics(buffers.imu, segment.start_s, segment.end_s);
   if (rest.count >= 2) {
     jp.accel_mean_m_s2 = rest.accel_mean_m_s2;
     jp.accel_mean_cov = rest.accel_mean_cov;
@@ -159,23 +118,25 @@ StationaryWindow::Entry CalibrationPipeline::Impl::jointMeasurements(
   }
   // The gyro since the previous rest: linked only while the chain holds (the same coverage test
   // as the gyro chain's integration).
-  const double density = std::max(rest.gyro_noise_density_rad_s_sqrt_hz, last_gyro_noise_density);
+  const double density =
+      std::max(rest.gyro_noise_density_rad_s_sqrt_hz, joint_gyro.last_noise_density);
   if (!pose.R_imu_previous_imu_gyro) {
-    joint_gyro_pending.reset();
-  } else if (joint_gyro_pending) {
-    appendGyroSamples(imu_buffer, chain_segment.end_s, segment.start_s, &*joint_gyro_pending);
-    joint_gyro_pending->noise_density_rad_s_sqrt_hz =
-        std::max(joint_gyro_pending->noise_density_rad_s_sqrt_hz, density);
-    entry.gyro_from_previous = joint_gyro_pending;
+    joint_gyro.pending.reset();
+  } else if (joint_gyro.pending) {
+    appendGyroSamples(buffers.imu, chain.segment.end_s, segment.start_s, &*joint_gyro.pending);
+    joint_gyro.pending->noise_density_rad_s_sqrt_hz =
+        std::max(joint_gyro.pending->noise_density_rad_s_sqrt_hz, density);
+    entry.gyro_from_previous = joint_gyro.pending;
     // Should this rest become no pose, its own samples join the motion to the next pose.
-    appendGyroSamples(imu_buffer, segment.start_s, segment.end_s, &*joint_gyro_pending);
-    const auto& stamps = joint_gyro_pending->stamps_s;
-    if (!stamps.empty() && stamps.back() - stamps.front() > settings.max_gyro_span_s) {
-      joint_gyro_pending.reset();  // as long a motion breaks the gyro chain too
+    appendGyroSamples(buffers.imu, segment.start_s, segment.end_s, &*joint_gyro.pending);
+    const auto& gyro_stamps = joint_gyro.pending->stamps_s;
+    if (!gyro_stamps.empty() &&
+        gyro_stamps.back() - gyro_stamps.front() > settings.max_gyro_span_s) {
+      joint_gyro.pending.reset();  // as long a motion breaks the gyro chain too
     }
   }
   if (rest.gyro_noise_density_rad_s_sqrt_hz > 0.0) {
-    last_gyro_noise_density = rest.gyro_noise_density_rad_s_sqrt_hz;
+    joint_gyro.last_noise_density = rest.gyro_noise_density_rad_s_sqrt_hz;
   }
   return entry;
 }
@@ -183,9 +144,9 @@ StationaryWindow::Entry CalibrationPipeline::Impl::jointMeasurements(
 SegmentField CalibrationPipeline::Impl::assessMagnetometer(const StationarySegment& segment,
                                                            StationaryPose* pose) {
   // Usable when there are samples, the attitude is defined and the field is undisturbed.
-  const SegmentField field = segmentField(mag_buffer, segment.start_s, segment.end_s);
+  const SegmentField field = segmentField(buffers.mag, segment.start_s, segment.end_s);
   if (field.count < kMinFieldSamples) {
-    pose->magnetometer_note = field.count == 0 && num_mag == 0
+    pose->magnetometer_note = field.count == 0 && counts.magnetic == 0
                                   ? "no magnetometer data"
                                   : "only " + std::to_string(field.count) + " field samples";
     return field;
@@ -207,20 +168,20 @@ SegmentField CalibrationPipeline::Impl::assessMagnetometer(const StationarySegme
 void CalibrationPipeline::Impl::integrateGyroSincePrevious(const StationarySegment& segment,
                                                            StationaryPose* pose) const {
   // Bias: mean of the two rests' gyro means.
-  if (!chain_valid) return;
-  const double t0 = chain_segment.end_s, t1 = segment.start_s;
-  const bool covered = !imu_buffer.empty() && !imu_buffer_truncated &&
-                       imu_buffer.front().stamp_s <= t0 + settings.stationary.max_gap_s &&
+  if (!chain.valid) return;
+  const double t0 = chain.segment.end_s, t1 = segment.start_s;
+  const bool covered = !buffers.imu.empty() && !buffers.imu_truncated &&
+                       buffers.imu.front().stamp_s <= t0 + settings.stationary.max_gap_s &&
                        t1 - t0 <= settings.max_gyro_span_s;
   Eigen::Matrix3d R_prev_cur;
-  const Eigen::Vector3d bias = 0.5 * (chain_segment.gyro_bias_rad_s + segment.gyro_bias_rad_s);
-  if (covered && integrateGyro(std::vector<ImuSample>(imu_buffer.begin(), imu_buffer.end()), bias,
+  const Eigen::Vector3d bias = 0.5 * (chain.segment.gyro_bias_rad_s + segment.gyro_bias_rad_s);
+  if (covered && integrateGyro(std::vector<ImuSample>(buffers.imu.begin(), buffers.imu.end()), bias,
                                t0, t1, &R_prev_cur, settings.stationary.max_gap_s)) {
     pose->R_imu_previous_imu_gyro = projectToSO3(R_prev_cur);
   }
-  if (pose->R_imu_previous_imu_gyro && pose->R_world_imu_accel_mag && chain_R_world_imu_accel_mag) {
+  if (pose->R_imu_previous_imu_gyro && pose->R_world_imu_accel_mag && chain.R_world_imu_accel_mag) {
     const Eigen::Matrix3d B_mag =
-        chain_R_world_imu_accel_mag->transpose() * *pose->R_world_imu_accel_mag;
+        chain.R_world_imu_accel_mag->transpose() * *pose->R_world_imu_accel_mag;
     pose->gyro_mag_difference_deg =
         rad2deg(rotationAngle(pose->R_imu_previous_imu_gyro->transpose() * B_mag));
   }
@@ -232,98 +193,43 @@ void CalibrationPipeline::Impl::chooseImuOrientation(const StationarySegment& se
   const bool prefer_mag = settings.imu_orientation == ImuOrientationSource::kMagnetometer;
   const std::optional<Eigen::Matrix3d> R_message =
       settings.imu_orientation == ImuOrientationSource::kMessage
-          ? messageOrientation(imu_buffer, segment.start_s, segment.end_s)
+          ? messageOrientation(buffers.imu, segment.start_s, segment.end_s)
           : std::nullopt;
   if (R_message) {
-    if (chain_valid && !group_message) ++group;  // the sensor's frame, unrelated to ours
-    group_message = true;
-    group_magnetic = false;
+    if (chain.valid && !chain.group_message) ++chain.group;  // the sensor's frame, not ours
+    chain.group_message = true;
+    chain.group_magnetic = false;
     pose->R_world_imu = *R_message;
     pose->imu_source = PoseImuSource::kMessage;
   } else if (pose->R_imu_previous_imu_gyro &&
-             !(prefer_mag && pose->magnetometer_usable && group_magnetic)) {
-    pose->R_world_imu = projectToSO3(chain_R_world_imu * *pose->R_imu_previous_imu_gyro);
+             !(prefer_mag && pose->magnetometer_usable && chain.group_magnetic)) {
+    pose->R_world_imu = projectToSO3(chain.R_world_imu * *pose->R_imu_previous_imu_gyro);
     pose->imu_source = PoseImuSource::kGyro;
   } else if (pose->magnetometer_usable) {
-    if (chain_valid && !group_magnetic) ++group;  // the old chain's heading was arbitrary
-    group_magnetic = true;
-    group_message = false;
+    if (chain.valid && !chain.group_magnetic) ++chain.group;  // the old heading was arbitrary
+    chain.group_magnetic = true;
+    chain.group_message = false;
     pose->R_world_imu = *pose->R_world_imu_accel_mag;
     pose->imu_source = PoseImuSource::kAccelMag;
   } else {
-    if (chain_valid) ++group;  // heading unknown relative to everything before
-    group_magnetic = false;
-    group_message = false;
+    if (chain.valid) ++chain.group;  // heading unknown relative to everything before
+    chain.group_magnetic = false;
+    chain.group_message = false;
     pose->R_world_imu = attitudeFromAccel(segment.mean_accel_m_s2);
     pose->imu_source = PoseImuSource::kAccelOnly;
   }
-  pose->group = group;
-  chain_valid = true;
-  chain_segment = segment;
-  chain_R_world_imu = pose->R_world_imu;
-  chain_R_world_imu_accel_mag = pose->R_world_imu_accel_mag;
-  imu_buffer_truncated = false;
-  while (!imu_buffer.empty() && imu_buffer.front().stamp_s < segment.end_s) imu_buffer.pop_front();
-  while (!mag_buffer.empty() && mag_buffer.front().stamp_s < segment.end_s) mag_buffer.pop_front();
-}
-
-std::string CalibrationPipeline::Impl::assessCamera(const StationarySegment& segment,
-                                                    StationaryPose* pose) {
-  // The frames inside the segment, margins off both ends; later ones are kept for the next rest.
-  std::vector<Eigen::Matrix3d> rotations;
-  double reprojection_sum = 0.0;
-  Eigen::Matrix3d pnp_cov_sum = Eigen::Matrix3d::Zero();
-  const double lo = segment.start_s + settings.frame_margin_s;
-  const double hi = segment.end_s - settings.frame_margin_s;
-  for (const auto& d : detections) {
-    if (d.stamp_s < lo || d.stamp_s > hi) continue;
-    rotations.push_back(d.pose.R_target_cam);
-    reprojection_sum += d.pose.reprojection_rms_px;
-    pnp_cov_sum += d.pose.cov_rotation_rad2;
-    pose->p_target_cam = d.pose.p_target_cam;
+  pose->group = chain.group;
+  chain.valid = true;
+  chain.segment = segment;
+  chain.R_world_imu = pose->R_world_imu;
+  chain.R_world_imu_accel_mag = pose->R_world_imu_accel_mag;
+  buffers.imu_truncated = false;
+  while (!buffers.imu.empty() && buffers.imu.front().stamp_s < segment.end_s) {
+    buffers.imu.pop_front();
   }
-  std::vector<FrameDetection> later;
-  for (const auto& d : detections) {
-    if (d.stamp_s > segment.end_s) later.push_back(d);
+  while (!buffers.mag.empty() && buffers.mag.front().stamp_s < segment.end_s) {
+    buffers.mag.pop_front();
   }
-  detections.swap(later);
-  const int refused = camera_model.refusedIn(lo, hi);  // target seen, pose refused
-  const std::string refused_text = camera_model.endRest(lo, hi, segment.end_s);
-
-  if (static_cast<int>(rotations.size()) < settings.min_frames_per_pose) {
-    const std::string silent = silentCameraReason();
-    if (!silent.empty()) return silent;
-    std::string out = "target seen in " + std::to_string(rotations.size() + refused) +
-                      " frame(s), " + std::to_string(settings.min_frames_per_pose) +
-                      (refused > 0 ? " with a camera pose needed; " + refused_text : " needed");
-    if (!target_mismatch.empty()) out += " (" + target_mismatch + ")";
-    return out;
-  }
-  const RotationAverage average = averageRotations(rotations, 4.0 * settings.max_camera_spread_deg);
-  if (average.num_inliers < settings.min_frames_per_pose ||
-      average.spread_rms_deg > settings.max_camera_spread_deg) {
-    return "camera orientation scatter " + fmt(average.spread_rms_deg) + " deg over " +
-           std::to_string(rotations.size()) + " frames (limit " +
-           fmt(settings.max_camera_spread_deg) + ")";
-  }
-  pose->R_target_cam =
-      resolveSymmetry(average.mean, pose->R_world_imu, pose->group, poses, symmetries);
-  pose->num_frames = average.num_inliers;
-  pose->camera_spread_deg = average.spread_rms_deg;
-  pose->reprojection_rms_px = reprojection_sum / static_cast<double>(rotations.size());
-  pose->camera_pnp_cov_rad2 = pnp_cov_sum / static_cast<double>(rotations.size());
-  return "";
-}
-
-std::string CalibrationPipeline::Impl::silentCameraReason() const {
-  // Nothing arrived at all: the caller may name the silent topic (kNoCameraDataReason). Images
-  // that came without intrinsics are the camera info's fault.
-  if (num_frames == 0) return kNoCameraDataReason;
-  if (!intrinsics && frames_without_intrinsics > 0) {
-    return "no camera info received yet (" + std::to_string(frames_without_intrinsics) +
-           " image(s) waiting for it)";
-  }
-  return "";
 }
 
 void CalibrationPipeline::Impl::acceptPose(const StationaryPose& pose,
@@ -349,9 +255,9 @@ void CalibrationPipeline::Impl::acceptPose(const StationaryPose& pose,
   joint_entry.joint.group = pose.group;
   joint_entry.pose = pose;
   window.add(std::move(joint_entry));
-  joint_gyro_pending = GyroSegment{};  // the next motion starts at this rest
-  pushBounded(&poses, pose);
-  ++poses_total;
+  joint_gyro.pending = GyroSegment{};  // the next motion starts at this rest
+  pushBounded(&records.poses, pose);
+  ++records.poses_total;
   if (callbacks.on_pose) callbacks.on_pose(pose);
 }
 
@@ -368,7 +274,7 @@ WindowSnapshot CalibrationPipeline::Impl::snapshot() const {
     addMotion(window_poses.empty() ? -1e300 : window_poses.front().start_s, &out.joint);
   }
   for (const StationaryPose& pose : window.poses()) out.pose_indices.push_back(pose.index);
-  out.scene_links = sceneLinkRefitter(out.joint, out.pose_indices);
+  out.scene_links = source->sceneLinkRefitter(out.joint, out.pose_indices);
   return out;
 }
 

@@ -1,14 +1,17 @@
-// CalibrationPipeline without a target: each rest's sharpest frame gives natural-scene features;
-// the camera's rotation from earlier rests (vision/scene_rotation.h) links the poses in the joint
-// estimate (JointProblem::camera_links) and chains their orientations in a scene frame for the
-// pair solvers.
+// The natural-scene source (no target: TargetDescription::numPoints() == 0): each rest's sharpest
+// frame gives natural-scene features; the camera's rotation from earlier rests
+// (vision/scene_rotation.h) links the poses in the joint estimate (JointProblem::camera_links) and
+// chains their orientations in a scene frame for the pair solvers. During motion it gives nothing.
 #include <algorithm>
 #include <cmath>
+#include <deque>
+#include <limits>
+#include <map>
 #include <sstream>
 
-#include "calibration_pipeline_impl.h"
 #include "camera_imu_alignment/estimation/joint_estimator.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
+#include "camera_source.h"
 
 namespace camera_imu_alignment {
 namespace {
@@ -34,38 +37,89 @@ double rmsSigmaDeg(const Eigen::Matrix3d& cov_rad2) {
   return rad2deg(std::sqrt(std::max(0.0, cov_rad2.trace()) / 3.0));
 }
 
-}  // namespace
+/// The features of an accepted pose's view, newest last (at most window_poses + 1).
+struct SceneView {
+  int pose_index = 0, scene = 0, group = 0;
+  Eigen::Matrix3d R_scene_cam = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d R_world_imu = Eigen::Matrix3d::Identity();  ///< the pose's (gyro chain)
+  std::shared_ptr<const SceneFeatures> features;              ///< shared with the snapshots' refits
+};
 
-void CalibrationPipeline::Impl::keepSceneCandidate(const CameraFrame& frame) {
+class SceneSource : public CameraSource {
+ public:
+  explicit SceneSource(const CameraSourceSetup& setup)
+      : settings_(setup.settings), inputs_(setup.inputs), reject_(setup.reject) {}
+
+  std::string describe() const override { return "images of the natural scene (no target)"; }
+  void takeRestFrame(const CameraFrame& frame, std::optional<double> rest_since_s,
+                     const PoseHistoryView& history) override;
+  /// No target to find during motion.
+  std::optional<MotionFrame> takeMotionFrame(const CameraFrame&, const MotionFrame*) override {
+    return std::nullopt;
+  }
+  /// The camera orientation from features matched with earlier rests (the links go into
+  /// `entry`).
+  std::string assessRest(const StationarySegment& segment, const PoseHistoryView& history,
+                         StationaryPose* pose, StationaryWindow::Entry* entry) override;
+  std::shared_ptr<const SceneLinkRefitter> sceneLinkRefitter(
+      const JointProblem& problem, const std::vector<int>& pose_indices) const override;
+  void rememberRefits(const std::vector<SceneRefit>& refits) override;
+
+ private:
+  /// A frame at rest (min_frame_interval_s apart) since the last rest ended.
+  struct Candidate {
+    double stamp_s = 0, sharpness = 0;
+    cv::Mat mono8;
+  };
+
+  const PipelineSettings& settings_;
+  CameraInputs& inputs_;
+  RejectInput reject_;
+  std::deque<Candidate> candidates_;
+  std::deque<SceneView> views_;
+  /// Links fitted again with the rotation held (WindowSnapshot::scene_links), by their poses'
+  /// StationaryPose::index, as solves returned them (rememberRefits): a later solve with nearly
+  /// the same prediction reuses the fit.
+  SceneRefitMemory refits_;
+  /// The matches of each link (by its poses' StationaryPose::index), for fitting it again.
+  std::map<std::pair<int, int>, std::shared_ptr<const SceneMatches>> link_matches_;
+  int scenes_started_ = 0;
+  std::uint64_t rotations_refused_by_imu_ = 0;  ///< scene rotations the IMU's angle contradicts
+};
+
+void SceneSource::takeRestFrame(const CameraFrame& frame, std::optional<double>,
+                                const PoseHistoryView&) {
+  if (!imageFitsIntrinsics(frame, &inputs_, reject_)) return;
   // Which frame is the sharpest inside the rest is known only when the rest ends (its margins):
   // every frame is kept, spaced as detection would be.
-  if (!scene_candidates.empty() &&
-      frame.stamp_s - scene_candidates.back().stamp_s < settings.min_frame_interval_s) {
+  if (!candidates_.empty() &&
+      frame.stamp_s - candidates_.back().stamp_s < settings_.min_frame_interval_s) {
     return;
   }
-  scene_candidates.push_back({frame.stamp_s, imageSharpness(frame.mono8), frame.mono8.clone()});
-  while (scene_candidates.size() > kMaxSceneCandidates) scene_candidates.pop_front();
+  candidates_.push_back({frame.stamp_s, imageSharpness(frame.mono8), frame.mono8.clone()});
+  while (candidates_.size() > kMaxSceneCandidates) candidates_.pop_front();
 }
 
-std::string CalibrationPipeline::Impl::assessScene(const StationarySegment& segment,
-                                                   StationaryPose* pose,
-                                                   StationaryWindow::Entry* entry) {
+std::string SceneSource::assessRest(const StationarySegment& segment,
+                                    const PoseHistoryView& history, StationaryPose* pose,
+                                    StationaryWindow::Entry* entry) {
+  const PipelineSettings& settings = settings_;
   const double lo = segment.start_s + settings.frame_margin_s;
   const double hi = segment.end_s - settings.frame_margin_s;
-  std::optional<SceneCandidate> best;
-  for (const SceneCandidate& c : scene_candidates) {
+  std::optional<Candidate> best;
+  for (const Candidate& c : candidates_) {
     if (c.stamp_s < lo || c.stamp_s > hi) continue;
     if (!best || c.sharpness > best->sharpness) best = c;
   }
-  while (!scene_candidates.empty() && scene_candidates.front().stamp_s <= segment.end_s) {
-    scene_candidates.pop_front();
+  while (!candidates_.empty() && candidates_.front().stamp_s <= segment.end_s) {
+    candidates_.pop_front();
   }
   if (!best) {
-    const std::string silent = silentCameraReason();
+    const std::string silent = silentCameraReason(inputs_);
     return silent.empty() ? "natural scene: no image inside the rest" : silent;
   }
-  SceneFeatures features =
-      extractSceneFeatures(best->mono8, *intrinsics, settings.scene_features, best->stamp_s);
+  SceneFeatures features = extractSceneFeatures(best->mono8, *inputs_.intrinsics,
+                                                settings.scene_features, best->stamp_s);
   const int count = static_cast<int>(features.keypoints.size());
   pose->camera_source = PoseCameraSource::kScene;
   pose->scene_features = count;
@@ -78,8 +132,8 @@ std::string CalibrationPipeline::Impl::assessScene(const StationarySegment& segm
   // The IMU's prediction of each rotation once the window's pairs give an R_cam_imu (seeds the
   // two-view fit: a near-planar view's essential matrix is ambiguous).
   std::optional<Eigen::Matrix3d> R_cam_imu_guess;
-  if (window.size() >= 3) {
-    const RotationPairs pairs = window.pairs();
+  if (history.window.size() >= 3) {
+    const RotationPairs pairs = history.window.pairs();
     if (!pairs.empty()) {
       const AlignmentResult guess = solveAlignment(pairs, settings.solver);
       if (guess.status == SolveStatus::kOk && guess.R_cam_imu.allFinite()) {
@@ -93,15 +147,15 @@ std::string CalibrationPipeline::Impl::assessScene(const StationarySegment& segm
   const SceneView* anchor = nullptr;
   SceneRotation anchor_rotation;
   int tried = 0;
-  for (auto it = scene_views.rbegin();
-       it != scene_views.rend() && tried < settings.max_scene_matches; ++it, ++tried) {
+  for (auto it = views_.rbegin(); it != views_.rend() && tried < settings.max_scene_matches;
+       ++it, ++tried) {
     std::optional<Eigen::Matrix3d> prediction;
     if (R_cam_imu_guess && it->group == pose->group) {
       prediction = *R_cam_imu_guess * it->R_world_imu.transpose() * pose->R_world_imu *
                    R_cam_imu_guess->transpose();
     }
-    SceneRotation rotation = estimateSceneRotation(*it->features, features, *intrinsics, prediction,
-                                                   settings.scene_rotation);
+    SceneRotation rotation = estimateSceneRotation(*it->features, features, *inputs_.intrinsics,
+                                                   prediction, settings.scene_rotation);
     if (rotation.ok && it->group == pose->group) {
       const double imu_deg =
           rad2deg(rotationAngle(it->R_world_imu.transpose() * pose->R_world_imu));
@@ -116,7 +170,7 @@ std::string CalibrationPipeline::Impl::assessScene(const StationarySegment& segm
         rotation.message = "the camera turned " + fmt(camera_deg) + " deg, the IMU " +
                            fmt(imu_deg) + " deg (" + std::to_string(rotation.inliers) +
                            " inliers): not used";
-        ++rotations_refused_by_imu;
+        ++rotations_refused_by_imu_;
       }
     }
     if (!rotation.ok) {
@@ -140,7 +194,7 @@ std::string CalibrationPipeline::Impl::assessScene(const StationarySegment& segm
       summary.alternatives.push_back(a.R_from_to);
     }
     entry->camera_links.push_back(link);
-    scene_link_matches[{it->pose_index, pose->index}] =
+    link_matches_[{it->pose_index, pose->index}] =
         std::make_shared<const SceneMatches>(rotation.matched);
     pose->scene_links.push_back(std::move(summary));
     if (!anchor || rotation.inliers > anchor_rotation.inliers) {
@@ -158,32 +212,27 @@ std::string CalibrationPipeline::Impl::assessScene(const StationarySegment& segm
       pose->scene_note = "the view at " + fmt(best->stamp_s) + " s (" + std::to_string(count) +
                          " features) overlaps none of the " + std::to_string(tried) +
                          " latest rests (best: " + best_failure + "): it starts scene " +
-                         std::to_string(scenes_started);
+                         std::to_string(scenes_started_);
     }
-    pose->scene = scenes_started++;
+    pose->scene = scenes_started_++;
     pose->R_target_cam = Eigen::Matrix3d::Identity();
   }
   pose->num_frames = 1;
   pose->camera_spread_deg = 0.0;
   entry->joint.camera_absolute = false;
-  scene_views.push_back({pose->index, pose->scene, pose->group, pose->R_target_cam,
-                         pose->R_world_imu,
-                         std::make_shared<const SceneFeatures>(std::move(features))});
-  while (scene_views.size() > settings.window_poses + 1) scene_views.pop_front();
+  views_.push_back({pose->index, pose->scene, pose->group, pose->R_target_cam, pose->R_world_imu,
+                    std::make_shared<const SceneFeatures>(std::move(features))});
+  while (views_.size() > settings.window_poses + 1) views_.pop_front();
   // The matches and refits of links whose first view is gone are not asked for again.
   const auto gone = [&](const std::pair<int, int>& key) {
-    return key.first < scene_views.front().pose_index;
+    return key.first < views_.front().pose_index;
   };
-  while (!scene_link_matches.empty() && gone(scene_link_matches.begin()->first)) {
-    scene_link_matches.erase(scene_link_matches.begin());
+  while (!link_matches_.empty() && gone(link_matches_.begin()->first)) {
+    link_matches_.erase(link_matches_.begin());
   }
-  while (!scene_refits.empty() && gone(scene_refits.begin()->first)) {
-    scene_refits.erase(scene_refits.begin());
-  }
+  while (!refits_.empty() && gone(refits_.begin()->first)) refits_.erase(refits_.begin());
   return "";
 }
-
-namespace {
 
 /// The pipeline's refitter: the window's views (features shared read-only), the links' matches,
 /// the intrinsics and a copy of the remembered fits of its links.
@@ -222,13 +271,12 @@ class ViewSceneLinkRefitter : public SceneLinkRefitter {
   }
 };
 
-}  // namespace
-
-std::shared_ptr<const SceneLinkRefitter> CalibrationPipeline::Impl::sceneLinkRefitter(
+std::shared_ptr<const SceneLinkRefitter> SceneSource::sceneLinkRefitter(
     const JointProblem& problem, const std::vector<int>& pose_indices) const {
-  if (!natural_scene || !intrinsics || problem.camera_links.empty()) return nullptr;
+  const std::optional<CameraIntrinsics>& intrinsics = inputs_.intrinsics;
+  if (!intrinsics || problem.camera_links.empty()) return nullptr;
   auto refitter = std::make_shared<ViewSceneLinkRefitter>();
-  for (const SceneView& v : scene_views) refitter->views[v.pose_index] = v.features;
+  for (const SceneView& v : views_) refitter->views[v.pose_index] = v.features;
   const auto global = [&](int local) {
     return local >= 0 && local < static_cast<int>(pose_indices.size())
                ? pose_indices[static_cast<std::size_t>(local)]
@@ -237,28 +285,31 @@ std::shared_ptr<const SceneLinkRefitter> CalibrationPipeline::Impl::sceneLinkRef
   for (const CameraLink& link : problem.camera_links) {
     const SceneLinkKey key(global(link.from_pose), global(link.to_pose));
     refitter->link_poses.push_back(key);
-    const auto matched = scene_link_matches.find(key);
-    refitter->link_matches.push_back(matched == scene_link_matches.end() ? nullptr
-                                                                         : matched->second);
-    const auto fit = scene_refits.find(key);
-    if (fit != scene_refits.end()) refitter->remembered_fits.insert(*fit);
+    const auto matched = link_matches_.find(key);
+    refitter->link_matches.push_back(matched == link_matches_.end() ? nullptr : matched->second);
+    const auto fit = refits_.find(key);
+    if (fit != refits_.end()) refitter->remembered_fits.insert(*fit);
   }
   const double focal = std::sqrt(intrinsics->K(0, 0) * intrinsics->K(1, 1));
   refitter->reuse_rad = kRefitReuseShare * kHeldRotationGatePx / focal;
   refitter->intrinsics = *intrinsics;
-  refitter->scene_settings = settings.scene_rotation;
+  refitter->scene_settings = settings_.scene_rotation;
   return refitter;
 }
 
-void CalibrationPipeline::rememberSceneRefits(const std::vector<SceneRefit>& refits) {
+void SceneSource::rememberRefits(const std::vector<SceneRefit>& refits) {
   for (const SceneRefit& fit : refits) {
     if (fit.key.first < 0 || fit.key.second < 0) continue;
-    // Only links whose views the pipeline still holds (a later solve may ask for them again).
-    if (impl_->scene_views.empty() || fit.key.first < impl_->scene_views.front().pose_index) {
-      continue;
-    }
-    impl_->scene_refits[fit.key] = fit;
+    // Only links whose views the source still holds (a later solve may ask for them again).
+    if (views_.empty() || fit.key.first < views_.front().pose_index) continue;
+    refits_[fit.key] = fit;
   }
+}
+
+}  // namespace
+
+std::unique_ptr<CameraSource> makeSceneSource(const CameraSourceSetup& setup) {
+  return std::make_unique<SceneSource>(setup);
 }
 
 }  // namespace camera_imu_alignment
