@@ -4,8 +4,8 @@
 #include <cstdint>
 #include <string>
 
+#include "camera_imu_alignment/common/input_error.h"
 #include "camera_imu_alignment/config/pipeline_config.h"
-#include "camera_imu_alignment/io/input_error.h"
 #include "camera_imu_alignment/io/result_yaml.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/vision/target_description.h"

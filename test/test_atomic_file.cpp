@@ -9,10 +9,10 @@
 #include <random>
 #include <string>
 
+#include "camera_imu_alignment/common/input_error.h"
 #include "camera_imu_alignment/io/atomic_file.h"
 #include "camera_imu_alignment/io/calibration_report.h"
 #include "camera_imu_alignment/io/csv_io.h"
-#include "camera_imu_alignment/io/input_error.h"
 #include "report_inputs.h"
 #include "test_helpers.h"
 

@@ -20,7 +20,7 @@
 #include <random>
 #include <string>
 
-#include "camera_imu_alignment/results/joint_result.h"
+#include "camera_imu_alignment/estimation/joint_result.h"
 #include "camera_imu_alignment/solver/rotation_pair.h"
 
 namespace camera_imu_alignment {

@@ -193,19 +193,6 @@ TEST(MountChange, NoFalseAlarmOnAnUnchangedMount) {
   }
 }
 
-TEST(MountChange, SettingsValidated) {
-  MountChangeSettings s;
-  EXPECT_EQ(s.validate(), "");
-  s.min_poses_after = 1;
-  EXPECT_NE(s.validate().find("remount_min_poses_after"), std::string::npos);
-  s = MountChangeSettings{};
-  s.level = 0.0;
-  EXPECT_NE(s.validate().find("remount_level"), std::string::npos);
-  s = MountChangeSettings{};
-  s.max_poses_after = 1;
-  EXPECT_NE(s.validate().find("remount_max_poses_after"), std::string::npos);
-}
-
 /// The simulation's cameras as the natural scene measures them (JointProblem::camera_links,
 /// camera_absolute false): the true rotation from each pose to the next two, the camera of poses
 /// `first_after`.. seen through a mount turned by `turn` (R_target_cam' = R_target_cam turn^T),

@@ -40,7 +40,7 @@ TEST(Observability, SingleAxisMotionIsNotObservableAndNamesTheAxis) {
   for (double noise : {0.0, 0.002, 0.02}) {
     for (const auto& [axis, name] : axes) {
       const Eigen::Matrix3d X = randomRotation(rng);
-      const AlignmentResult r = solveAlignment(singleAxisPairs(rng, X, axis, 20, noise));
+      const PairSolveResult r = solveAlignment(singleAxisPairs(rng, X, axis, 20, noise));
       EXPECT_EQ(r.status, SolveStatus::kNotObservable) << "noise " << noise << " axis " << name;
       EXPECT_FALSE(r.quality.observable);
       EXPECT_GT(std::abs(r.quality.weak_axis_cam.dot(axis)), 0.99)
@@ -56,7 +56,7 @@ TEST(Observability, SingleAxisMotionIsNotObservableAndNamesTheAxis) {
 TEST(Observability, OnePairIsNotObservable) {
   std::mt19937_64 rng(32);
   const Eigen::Matrix3d X = randomRotation(rng);
-  const AlignmentResult r = solveAlignment({exactPair(X, randomRotation(rng))});
+  const PairSolveResult r = solveAlignment({exactPair(X, randomRotation(rng))});
   EXPECT_EQ(r.status, SolveStatus::kNotObservable);
   EXPECT_NE(r.message.find("rotate"), std::string::npos);
 }
@@ -81,7 +81,7 @@ TEST(Observability, NearlyDegenerateMotionIsObservableWithHonestSigma) {
       p.B_imu = p.B_imu * test::rotationFromVector(test::gaussianVector(rng, 0.002));
       pairs.push_back(p);
     }
-    const AlignmentResult r = solveAlignment(pairs);
+    const PairSolveResult r = solveAlignment(pairs);
     ASSERT_EQ(r.status, SolveStatus::kOk) << r.message;
     const Eigen::Vector3d err_deg = test::leftError(r.R_cam_imu, X) * 180.0 / test::kPiTest;
     for (int i = 0; i < 3; ++i) {
@@ -125,7 +125,7 @@ TEST(Observability, ReportedSigmaIsHonestForIndependentPairs) {
       p.B_imu = p.B_imu * test::rotationFromVector(test::gaussianVector(rng, 0.005));
       pairs.push_back(p);
     }
-    const AlignmentResult r = solveAlignment(pairs);
+    const PairSolveResult r = solveAlignment(pairs);
     ASSERT_EQ(r.status, SolveStatus::kOk);
     errs.push_back(test::leftError(r.R_cam_imu, X) * 180.0 / test::kPiTest);
     sigmas.push_back(r.quality.std_dev_deg);
@@ -150,7 +150,7 @@ TEST(Observability, ReportedSigmaIsHonestForPairsSharingPoses) {
                           test::rotationFromVector(test::gaussianVector(rng, 0.002));
       poses.push_back(pose);
     }
-    const AlignmentResult r = solveAlignment(makeAllPairs(poses));
+    const PairSolveResult r = solveAlignment(makeAllPairs(poses));
     ASSERT_EQ(r.status, SolveStatus::kOk);
     errs.push_back(test::leftError(r.R_cam_imu, X) * 180.0 / test::kPiTest);
     sigmas.push_back(r.quality.std_dev_deg);

@@ -24,7 +24,7 @@ RotationPairs exactPairs(std::mt19937_64& rng, const Eigen::Matrix3d& X, int J) 
 }
 
 void expectExact(const RotationPairs& pairs, const Eigen::Matrix3d& X, const std::string& what) {
-  const AlignmentResult r = solveAlignment(pairs);
+  const PairSolveResult r = solveAlignment(pairs);
   ASSERT_EQ(r.status, SolveStatus::kOk) << what << ": " << r.message;
   EXPECT_TRUE(r.R_cam_imu.allFinite()) << what;
   EXPECT_LT(angleBetweenDeg(r.R_cam_imu, X), 1e-9) << what;
@@ -74,7 +74,7 @@ TEST(OptimalSolver, PairsNear0And180DegreesGiveNoNaN) {
     for (int k = 0; k < 3; ++k)
       pairs.push_back(exactPair(X, axisAngle(randomUnitVector(rng), angle)));
   }
-  const AlignmentResult r = solveAlignment(pairs);
+  const PairSolveResult r = solveAlignment(pairs);
   ASSERT_EQ(r.status, SolveStatus::kOk) << r.message;
   EXPECT_LT(angleBetweenDeg(r.R_cam_imu, X), 1e-9);
   for (const auto& d : r.quality.pairs) {
@@ -89,7 +89,7 @@ TEST(OptimalSolver, PairsNear0And180DegreesGiveNoNaN) {
     half_turns.push_back(exactPair(X, axisAngle(b, test::kPiTest)));
   }
   half_turns.push_back(exactPair(X, Eigen::Matrix3d::Identity()));
-  const AlignmentResult h = solveAlignment(half_turns);
+  const PairSolveResult h = solveAlignment(half_turns);
   ASSERT_EQ(h.status, SolveStatus::kOk) << h.message;
   EXPECT_LT(angleBetweenDeg(h.R_cam_imu, X), 1e-9);
 }
@@ -123,8 +123,8 @@ void outlierExperiment(double outlier_fraction, double* rms_all, double* rms_inl
       all[k] = bad;
       inliers.erase(inliers.begin());
     }
-    const AlignmentResult r_all = solveAlignment(all);
-    const AlignmentResult r_in = solveAlignment(inliers);
+    const PairSolveResult r_all = solveAlignment(all);
+    const PairSolveResult r_in = solveAlignment(inliers);
     ASSERT_EQ(r_all.status, SolveStatus::kOk) << r_all.message;
     for (int k = 0; k < n_out; ++k) {
       if (r_all.quality.pairs[k].inlier && r_all.quality.pairs[k].residual_deg > 5.0) ++*missed;
@@ -179,12 +179,12 @@ TEST(OptimalSolver, TwoStepMethodReturnsThePapersLeftIterate) {
   const RotationPairs pairs = test::paperPairs(rng, X, 20, 0.02);
   SolverOptions options;
   options.method = SolverMethod::kTwoStep;
-  const AlignmentResult r = solveAlignment(pairs, options);
+  const PairSolveResult r = solveAlignment(pairs, options);
   ASSERT_EQ(r.status, SolveStatus::kOk);
   EXPECT_EQ(r.R_cam_imu, r.two_step.R_cam_imu_left);
   EXPECT_EQ(r.iterations, r.two_step.iterations);
   // The default method also runs the two-step and reports it.
-  const AlignmentResult opt = solveAlignment(pairs);
+  const PairSolveResult opt = solveAlignment(pairs);
   EXPECT_GT(opt.two_step.iterations, 0);
   EXPECT_LT(angleBetweenDeg(opt.two_step.R_cam_imu_left, r.R_cam_imu), 1e-6);
 }
@@ -199,7 +199,7 @@ TEST(OptimalSolver, BadInputIsReportedNotSolved) {
   EXPECT_EQ(solveAlignment({scaled}).status, SolveStatus::kBadInput);
   RotationPair reflection;
   reflection.B_imu(2, 2) = -1.0;
-  const AlignmentResult r = solveAlignment({reflection});
+  const PairSolveResult r = solveAlignment({reflection});
   EXPECT_EQ(r.status, SolveStatus::kBadInput);
   EXPECT_NE(r.message.find("pair 0"), std::string::npos);
 }

@@ -55,10 +55,10 @@ MonteCarlo runPaperExperiment() {
     }
     mc.crb += fisher.inverse().trace() / kRuns;
 
-    const AlignmentResult optimal = solveAlignment(pairs);
+    const PairSolveResult optimal = solveAlignment(pairs);
     SolverOptions two_step_options;
     two_step_options.method = SolverMethod::kTwoStep;
-    const AlignmentResult two_step = solveAlignment(pairs, two_step_options);
+    const PairSolveResult two_step = solveAlignment(pairs, two_step_options);
     mc.mse_optimal += test::leftError(optimal.R_cam_imu, R0).squaredNorm() / kRuns;
     mc.mse_two_step += test::leftError(two_step.R_cam_imu, R0).squaredNorm() / kRuns;
     mc.two_step_converged += two_step.converged ? 1 : 0;

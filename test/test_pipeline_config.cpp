@@ -7,9 +7,12 @@
 #include <fstream>
 #include <set>
 
+#include "camera_imu_alignment/common/input_error.h"
 #include "camera_imu_alignment/config/online_config.h"
 #include "camera_imu_alignment/config/pipeline_config.h"
-#include "camera_imu_alignment/io/input_error.h"
+#include "camera_imu_alignment/config/settings_checks.h"
+#include "camera_imu_alignment/config/settings_error.h"
+#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
 #include "camera_imu_alignment/ros/wrapper_settings.h"
 #include "test_helpers.h"
 
@@ -340,6 +343,30 @@ TEST(PipelineConfig, RosOnlyKeysCanBeSkippedAndPartialFilesKeepTheRest) {
   parsePipelineConfig("camera_frame: cam\nwindow_poses: 12\n", "params.yaml", &s, {"camera_frame"});
   EXPECT_EQ(s.window_poses, 12u);
   EXPECT_EQ(s.stationary.window_s, PipelineSettings().stationary.window_s);
+}
+
+TEST(Settings, AStructInCodeIsCheckedByTheSameTablesAndRulesAsAFile) {
+  // One check for settings handed to the library: findProblem, with the key the file would name.
+  EXPECT_FALSE(findProblem(OnlineSettings{}).has_value());
+  EXPECT_FALSE(findProblem(PipelineSettings{}).has_value());
+  OnlineSettings online;
+  online.remount.min_poses_after = 1;
+  ASSERT_TRUE(findProblem(online).has_value());
+  EXPECT_EQ(findProblem(online)->key, "remount_min_poses_after");
+  online = OnlineSettings{};
+  online.remount.level = 0.0;
+  ASSERT_TRUE(findProblem(online).has_value());
+  EXPECT_EQ(findProblem(online)->key, "remount_level");
+  online = OnlineSettings{};
+  online.remount.min_poses_after = 5;
+  online.remount.max_poses_after = 4;
+  ASSERT_TRUE(findProblem(online).has_value());
+  EXPECT_NE(findProblem(online)->message.find("remount_max_poses_after"), std::string::npos);
+  PipelineSettings pipeline;
+  pipeline.min_poses_to_solve = 40;
+  ASSERT_TRUE(findProblem(pipeline).has_value());
+  EXPECT_NE(findProblem(pipeline)->message.find("window_poses"), std::string::npos);
+  EXPECT_THROW(CalibrationPipeline(TargetDescription{}, pipeline), SettingsError);
 }
 
 }  // namespace

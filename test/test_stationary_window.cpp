@@ -139,7 +139,7 @@ TEST(StationaryWindow, PosesOfDifferentGroupsAreNeverPaired) {
     EXPECT_EQ(poses[pair.pose_k].group, poses[pair.pose_t].group);
     EXPECT_LT((pair.A_cam * X - X * pair.B_imu).norm(), 1e-12);
   }
-  const AlignmentResult result = solveAlignment(pairs);
+  const PairSolveResult result = solveAlignment(pairs);
   EXPECT_LT(test::angleBetweenDeg(result.R_cam_imu, X), 1e-6);
 }
 
@@ -168,7 +168,7 @@ TEST(StationaryWindow, NoiseFreePosesAreSolvedExactly) {
     for (const auto& p : exactPoses(rng, X, 8)) ASSERT_TRUE(window.add(entryOf(p)));
     const RotationPairs pairs = window.pairs();
     ASSERT_EQ(pairs.size(), 28u);
-    const AlignmentResult r = solveAlignment(pairs);
+    const PairSolveResult r = solveAlignment(pairs);
     ASSERT_EQ(r.status, SolveStatus::kOk) << r.message;
     EXPECT_LT(test::angleBetweenDeg(r.R_cam_imu, X), 1e-9) << "trial " << trial;
     EXPECT_TRUE(r.quality.observable);

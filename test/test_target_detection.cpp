@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "camera_imu_alignment/io/input_error.h"
+#include "camera_imu_alignment/common/input_error.h"
 #include "camera_imu_alignment/simulation/renderer.h"
 #include "camera_imu_alignment/simulation/simulation_run.h"
 #include "camera_imu_alignment/solver/alignment_solver.h"
@@ -549,7 +549,7 @@ TEST(VispRealImages, AllChessboardsFoundAndRotationMatchesVisp) {
         << i;
     poses.push_back(p);
   }
-  const AlignmentResult result = solveAlignment(makeAllPairs(poses));
+  const PairSolveResult result = solveAlignment(makeAllPairs(poses));
   ASSERT_EQ(result.status, SolveStatus::kOk) << result.message;
   const double error_deg = test::angleBetweenDeg(result.R_cam_imu, test::vispCameraImu());
   std::cout << "ViSP Franka: R_cam_imu differs from ViSP's estimate by " << error_deg << " deg\n";

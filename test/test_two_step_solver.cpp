@@ -140,7 +140,7 @@ TEST(TwoStepSolver, FromIdentityItCanLockOntoAWrongFixedPointForLargeMountings) 
     for (int j = 0; j < 20; ++j) pairs.push_back(exactPair(X, randomRotation(rng)));
     const TwoStepResult r = solveTwoStep(pairs);
     if (angleBetweenDeg(r.R_cam_imu_left, X) > 1.0) ++wrong;
-    const AlignmentResult best = solveAlignment(pairs);
+    const PairSolveResult best = solveAlignment(pairs);
     EXPECT_LT(angleBetweenDeg(best.R_cam_imu, X), 1e-8);
   }
   EXPECT_GT(wrong, trials / 20) << "the two-step no longer fails here: update the documentation";

@@ -12,8 +12,8 @@
 
 #include "alignment_wrapper_impl.h"
 #include "camera_imu_alignment/AlignmentStatus.h"
+#include "camera_imu_alignment/common/input_error.h"
 #include "camera_imu_alignment/io/default_frames.h"
-#include "camera_imu_alignment/io/input_error.h"
 #include "camera_imu_alignment/io/result_yaml.h"
 #include "camera_imu_alignment/ros/message_conversion.h"
 #include "camera_imu_alignment/solver/rotation_math.h"

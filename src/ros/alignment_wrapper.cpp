@@ -9,7 +9,7 @@
 #include <ros/master.h>
 
 #include "alignment_wrapper_impl.h"
-#include "camera_imu_alignment/io/input_error.h"
+#include "camera_imu_alignment/common/input_error.h"
 #include "camera_imu_alignment/ros/message_conversion.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 #include "camera_imu_alignment/vision/target_description.h"

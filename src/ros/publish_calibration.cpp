@@ -12,10 +12,10 @@
 
 #include <exception>
 
+#include "camera_imu_alignment/common/input_error.h"
 #include "camera_imu_alignment/config/settings_error.h"
 #include "camera_imu_alignment/io/default_frames.h"
 #include "camera_imu_alignment/io/exit_codes.h"
-#include "camera_imu_alignment/io/input_error.h"
 #include "camera_imu_alignment/io/result_yaml.h"
 #include "camera_imu_alignment/ros/message_conversion.h"
 #include "camera_imu_alignment/ros/wrapper_settings.h"

@@ -9,10 +9,10 @@
 #include <filesystem>
 #include <sstream>
 
+#include "camera_imu_alignment/common/input_error.h"
 #include "camera_imu_alignment/config/online_config.h"
 #include "camera_imu_alignment/config/pipeline_config.h"
 #include "camera_imu_alignment/config/settings_checks.h"
-#include "camera_imu_alignment/io/input_error.h"
 
 namespace camera_imu_alignment {
 namespace {

@@ -23,12 +23,12 @@
 
 #include "bag_reader.h"
 #include "bag_topics.h"
+#include "camera_imu_alignment/common/input_error.h"
 #include "camera_imu_alignment/config/online_config.h"
 #include "camera_imu_alignment/config/pipeline_config.h"
 #include "camera_imu_alignment/io/calibration_summary.h"
 #include "camera_imu_alignment/io/default_frames.h"
 #include "camera_imu_alignment/io/exit_codes.h"
-#include "camera_imu_alignment/io/input_error.h"
 #include "camera_imu_alignment/io/result_yaml.h"
 #include "camera_imu_alignment/offline/recording_outcome.h"
 #include "camera_imu_alignment/online/online_calibrator.h"

@@ -39,7 +39,7 @@ const char* kUsage =
     "fit the data\n"
     "file formats, frames and quaternion order: see doc/CONVENTIONS.md in the package\n";
 
-void printSummary(const cia::AlignmentResult& r) {
+void printSummary(const cia::PairSolveResult& r) {
   const Eigen::Matrix3d& R = r.R_cam_imu;
   Eigen::Quaterniond q(R);
   if (q.w() < 0.0) q.coeffs() = -q.coeffs();
@@ -111,7 +111,7 @@ int run(int argc, char** argv) {
     }
   }
 
-  const cia::AlignmentResult result = cia::solveAlignment(pairs, options);
+  const cia::PairSolveResult result = cia::solveAlignment(pairs, options);
   if (result.status == cia::SolveStatus::kBadInput) {
     std::cerr << "error: " << result.message << "\n";
     return kExitBadInput;
@@ -128,7 +128,7 @@ int run(int argc, char** argv) {
     // iterations, so its value is not the two-step's answer).
     cia::SolverOptions alone = options;
     alone.method = cia::SolverMethod::kTwoStep;
-    const cia::AlignmentResult two_step =
+    const cia::PairSolveResult two_step =
         options.method == cia::SolverMethod::kTwoStep ? result : cia::solveAlignment(pairs, alone);
     const double err_two_step =
         cia::rad2deg(cia::geodesicDistance(two_step.R_cam_imu, truth->R_cam_imu));

@@ -13,9 +13,9 @@
 #include <optional>
 #include <string>
 
+#include "camera_imu_alignment/config/online_settings.h"
+#include "camera_imu_alignment/config/pipeline_settings.h"
 #include "camera_imu_alignment/config/setting_keys.h"
-#include "camera_imu_alignment/online/online_types.h"
-#include "camera_imu_alignment/pipeline/calibration_pipeline.h"
 
 namespace camera_imu_alignment {
 

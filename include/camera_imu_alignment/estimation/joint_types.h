@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "camera_imu_alignment/results/joint_result.h"
+#include "camera_imu_alignment/estimation/joint_result.h"
 
 namespace camera_imu_alignment {
 

@@ -66,8 +66,6 @@ struct MountChangeSettings {
   /// the motion left out around it (s), where the mount moved. Not setting keys.
   double min_motion_s = 3.0;
   double motion_gap_s = 1.0;
-  /// Returns "" when usable, else the first unusable setting, named by its key.
-  std::string validate() const;
 };
 
 /// One candidate split.

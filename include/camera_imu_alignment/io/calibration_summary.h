@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "camera_imu_alignment/estimation/alignment_result.h"
 #include "camera_imu_alignment/io/default_frames.h"
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
-#include "camera_imu_alignment/solver/alignment_solver.h"
 
 namespace camera_imu_alignment {
 

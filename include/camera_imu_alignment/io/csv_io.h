@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "camera_imu_alignment/io/input_error.h"
+#include "camera_imu_alignment/common/input_error.h"
 #include "camera_imu_alignment/solver/pose_window.h"
 #include "camera_imu_alignment/solver/rotation_pair.h"
 

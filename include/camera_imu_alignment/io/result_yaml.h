@@ -8,8 +8,8 @@
 #include <optional>
 #include <string>
 
+#include "camera_imu_alignment/estimation/alignment_result.h"
 #include "camera_imu_alignment/io/default_frames.h"
-#include "camera_imu_alignment/solver/alignment_solver.h"
 
 namespace camera_imu_alignment {
 

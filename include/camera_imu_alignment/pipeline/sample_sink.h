@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "camera_imu_alignment/config/pipeline_settings.h"
 #include "camera_imu_alignment/inertial/inertial_samples.h"
 #include "camera_imu_alignment/pipeline/input_rejections.h"
 #include "camera_imu_alignment/vision/camera_model.h"
@@ -27,15 +28,6 @@ struct CameraFrame {
   /// position); the joint estimate's acceleration model uses it during motion.
   std::optional<Eigen::Vector3d> p_target_cam_m;
 };
-
-/// Where the IMU orientation of a pose comes from (calibration_pipeline.h).
-enum class ImuOrientationSource { kJoint, kAuto, kMagnetometer, kMessage };
-const char* toString(ImuOrientationSource source);
-bool parseImuOrientationSource(const std::string& text, ImuOrientationSource* source);
-/// The modes whose answer is a joint maximum-likelihood estimate (estimation/joint_estimator.h):
-/// kJoint (every sensor) and kMagnetometer (camera, accelerometer and magnetometer, the gyro left
-/// out). The others answer with the pair solve.
-bool usesJointEstimate(ImuOrientationSource source);
 
 class SampleSink {
  public:

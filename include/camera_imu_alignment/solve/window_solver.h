@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "camera_imu_alignment/estimation/alignment_result.h"
 #include "camera_imu_alignment/estimation/mount_change.h"
 #include "camera_imu_alignment/pipeline/calibration_pipeline.h"
 #include "camera_imu_alignment/pipeline/scene_link_refitter.h"

@@ -7,7 +7,6 @@
 #include <string>
 #include <vector>
 
-#include "camera_imu_alignment/results/joint_result.h"
 #include "camera_imu_alignment/solver/optimal_solver.h"
 #include "camera_imu_alignment/solver/rotation_pair.h"
 #include "camera_imu_alignment/solver/solution_quality.h"
@@ -42,7 +41,9 @@ enum class SolveStatus {
 /// "ok", "not observable", "poor fit", "bad input" (as the summary and the report print it).
 const char* toString(SolveStatus status);
 
-struct AlignmentResult {
+/// The pair solve's answer. The window solve's answer (estimation/alignment_result.h) is this with
+/// the joint estimate beside it.
+struct PairSolveResult {
   SolveStatus status = SolveStatus::kBadInput;
   std::string message;  ///< one line for the user: what happened, what to do next
   SolverMethod method = SolverMethod::kOptimal;
@@ -54,20 +55,14 @@ struct AlignmentResult {
   int iterations = 0;      ///< iterations of the selected method
   bool converged = false;  ///< the selected method met its convergence test
   SolutionQuality quality;
-  /// The joint estimate (pipeline with imu_orientation: joint): when present and ok, R_cam_imu and
-  /// quality.std_dev_deg are its, the rest of `quality` is the pair solve's.
-  std::optional<JointResult> joint;
-  /// The window solve's stages that had something to say, "stage: note", in the order they ran
-  /// (solve/window_solver.h); empty for a bare pair solve.
-  std::vector<std::string> stage_notes;
 };
 
 /// Whether `result` holds a rotation at all (the outputs show none otherwise): any status but
 /// kBadInput, whose R_cam_imu is a placeholder (identity: no pairs, nothing solved), and finite.
 /// A kNotObservable or kPoorFit estimate is a best guess, shown as such.
-bool hasEstimate(const AlignmentResult& result);
+bool hasEstimate(const PairSolveResult& result);
 
 /// Solves A_j X = X B_j for X = R_cam_imu.
-AlignmentResult solveAlignment(const RotationPairs& pairs, const SolverOptions& options = {});
+PairSolveResult solveAlignment(const RotationPairs& pairs, const SolverOptions& options = {});
 
 }  // namespace camera_imu_alignment

@@ -1,5 +1,5 @@
 // The calibrator's setting keys (online_config.h): one table, one entry per key; its ranges are
-// OnlineSettings::validate()'s.
+// findProblem's.
 #include "camera_imu_alignment/config/online_config.h"
 
 #include <algorithm>
@@ -74,11 +74,6 @@ std::optional<SettingProblem> findProblem(const PipelineSettings& pipeline,
   if (auto problem = checkRanges(pipelineKeys(), pipeline)) return problem;
   if (auto problem = checkRanges(onlineKeys(), online)) return problem;
   return checkAcrossKeys(&pipeline, &online);
-}
-
-std::string OnlineSettings::validate() const {
-  const std::optional<SettingProblem> problem = findProblem(*this);
-  return problem ? problem->message : "";
 }
 
 void parseCalibrationConfig(

@@ -1,5 +1,5 @@
 // The pipeline's keys (pipeline_config.h): one table, one entry per key. Its ranges are
-// PipelineSettings::validate()'s; config/default.yaml holds the same keys with the struct's
+// findProblem's; config/default.yaml holds the same keys with the struct's
 // defaults (test_pipeline_config checks both directions).
 #include "camera_imu_alignment/config/pipeline_config.h"
 
@@ -234,11 +234,6 @@ const std::vector<SettingKey<PipelineSettings>>& pipelineKeys() { return keys();
 const std::vector<std::string>& pipelineConfigKeys() {
   static const std::vector<std::string> names = keyNames(keys());
   return names;
-}
-
-std::string PipelineSettings::validate() const {
-  const std::optional<SettingProblem> problem = findProblem(*this);
-  return problem ? problem->message : "";
 }
 
 void readPipelineKey(const std::string& source, const std::string& name, const YAML::Node& value,

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "camera_imu_alignment/results/joint_result.h"
+#include "camera_imu_alignment/estimation/joint_result.h"
 #include "camera_imu_alignment/solver/rotation_math.h"
 
 namespace camera_imu_alignment {

@@ -15,21 +15,6 @@
 
 namespace camera_imu_alignment {
 
-std::string MountChangeSettings::validate() const {
-  std::ostringstream out;
-  if (!(level > 0.0 && level < 1.0)) {
-    out << "remount_level = " << level << ": must be a number within (0, 1)";
-  } else if (min_poses_after < 2) {
-    out << "remount_min_poses_after = " << min_poses_after << ": must be an integer >= 2";
-  } else if (max_poses_after < min_poses_after) {
-    out << "remount_max_poses_after = " << max_poses_after
-        << ": must be an integer >= remount_min_poses_after (" << min_poses_after << ")";
-  } else if (min_poses_before < 2) {
-    out << "remount_min_poses_before = " << min_poses_before << ": must be an integer >= 2";
-  }
-  return out.str();
-}
-
 double fisherUpperTail(double f, int d1, int d2) {
   if (d1 <= 0 || d2 <= 0 || !std::isfinite(f)) return 1.0;
   if (f <= 0.0) return 1.0;

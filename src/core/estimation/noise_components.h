@@ -15,7 +15,7 @@
 
 #include <ceres/problem.h>
 
-#include "camera_imu_alignment/results/joint_result.h"
+#include "camera_imu_alignment/estimation/joint_result.h"
 #include "joint_state.h"
 
 namespace camera_imu_alignment {

@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <system_error>
 
-#include "camera_imu_alignment/io/input_error.h"
+#include "camera_imu_alignment/common/input_error.h"
 
 namespace camera_imu_alignment {
 namespace {

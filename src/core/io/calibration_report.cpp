@@ -10,8 +10,8 @@
 #include <sstream>
 #include <vector>
 
+#include "camera_imu_alignment/common/input_error.h"
 #include "camera_imu_alignment/io/atomic_file.h"
-#include "camera_imu_alignment/io/input_error.h"
 #include "camera_imu_alignment/io/joint_yaml.h"
 #include "camera_imu_alignment/io/report_figures.h"
 #include "camera_imu_alignment/solver/rotation_math.h"

@@ -9,7 +9,7 @@
 #include <sstream>
 #include <string>
 
-#include "camera_imu_alignment/solver/alignment_solver.h"
+#include "camera_imu_alignment/estimation/alignment_result.h"
 
 namespace camera_imu_alignment {
 namespace report_text {

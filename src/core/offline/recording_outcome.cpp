@@ -5,11 +5,11 @@
 #include <filesystem>
 #include <system_error>
 
+#include "camera_imu_alignment/common/input_error.h"
 #include "camera_imu_alignment/io/atomic_file.h"
 #include "camera_imu_alignment/io/calibration_report.h"
 #include "camera_imu_alignment/io/csv_io.h"
 #include "camera_imu_alignment/io/exit_codes.h"
-#include "camera_imu_alignment/io/input_error.h"
 #include "camera_imu_alignment/io/joint_yaml.h"
 
 namespace camera_imu_alignment {

@@ -16,19 +16,6 @@
 
 namespace camera_imu_alignment {
 
-const char* toString(ImuOrientationSource source) {
-  switch (source) {
-    case ImuOrientationSource::kMagnetometer:
-      return "magnetometer";
-    case ImuOrientationSource::kMessage:
-      return "message";
-    case ImuOrientationSource::kJoint:
-      return "joint";
-    default:
-      return "auto";
-  }
-}
-
 const char* toString(PoseImuSource source) {
   switch (source) {
     case PoseImuSource::kGyro:
@@ -45,31 +32,6 @@ const char* toString(PoseImuSource source) {
 
 const char* toString(PoseCameraSource source) {
   return source == PoseCameraSource::kScene ? "scene" : "target";
-}
-
-bool usesJointEstimate(ImuOrientationSource source) {
-  return source == ImuOrientationSource::kJoint || source == ImuOrientationSource::kMagnetometer;
-}
-
-bool parseImuOrientationSource(const std::string& text, ImuOrientationSource* source) {
-  if (text == "joint") {
-    *source = ImuOrientationSource::kJoint;
-  } else if (text == "auto") {
-    *source = ImuOrientationSource::kAuto;
-  } else if (text == "magnetometer") {
-    *source = ImuOrientationSource::kMagnetometer;
-  } else if (text == "message") {
-    *source = ImuOrientationSource::kMessage;
-  } else {
-    return false;
-  }
-  return true;
-}
-
-JointSettings jointSettingsOf(const PipelineSettings& settings) {
-  JointSettings joint = settings.joint;
-  joint.gravity_m_s2 = settings.stationary.gravity_m_s2;
-  return joint;
 }
 
 namespace {

@@ -135,7 +135,7 @@ std::string SceneSource::assessRest(const StationarySegment& segment,
   if (history.window.size() >= 3) {
     const RotationPairs pairs = history.window.pairs();
     if (!pairs.empty()) {
-      const AlignmentResult guess = solveAlignment(pairs, settings.solver);
+      const PairSolveResult guess = solveAlignment(pairs, settings.solver);
       if (guess.status == SolveStatus::kOk && guess.R_cam_imu.allFinite()) {
         R_cam_imu_guess = guess.R_cam_imu;
       }

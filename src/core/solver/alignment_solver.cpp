@@ -26,7 +26,7 @@ const char* toString(SolveStatus status) {
   return "unknown";
 }
 
-bool hasEstimate(const AlignmentResult& result) {
+bool hasEstimate(const PairSolveResult& result) {
   return result.status != SolveStatus::kBadInput && result.R_cam_imu.allFinite();
 }
 
@@ -41,8 +41,8 @@ bool parseSolverMethod(const std::string& text, SolverMethod* method) {
   return true;
 }
 
-AlignmentResult solveAlignment(const RotationPairs& pairs, const SolverOptions& options) {
-  AlignmentResult result;
+PairSolveResult solveAlignment(const RotationPairs& pairs, const SolverOptions& options) {
+  PairSolveResult result;
   result.method = options.method;
   if (pairs.empty()) {
     result.message = "no rotation pairs to solve";

@@ -7,7 +7,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "camera_imu_alignment/io/input_error.h"
+#include "camera_imu_alignment/common/input_error.h"
 
 namespace camera_imu_alignment {
 

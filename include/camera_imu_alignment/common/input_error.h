@@ -1,7 +1,8 @@
 // The one exception type for bad input files and settings: CSV and YAML readers, the target
-// description, the pipeline's and the nodelet's settings. Its message names the file (and line) or
-// the key, so a caller prints it as it is. It is an std::invalid_argument; a bad setting is its
-// subclass SettingsError (config/settings_error.h).
+// description (vision), the pipeline's and the nodelet's settings. Header-only and below every
+// room, so that vision, io and config throw the same type without depending on each other. Its
+// message names the file (and line) or the key, so a caller prints it as it is. It is an
+// std::invalid_argument; a bad setting is its subclass SettingsError (config/settings_error.h).
 #pragma once
 
 #include <stdexcept>

@@ -1,6 +1,6 @@
 // What the joint maximum-likelihood estimate (estimation/joint_estimator.h) answers: R_cam_imu with
-// its covariance, the IMU model at the estimate and the chi-square consistency figures. A room of
-// its own so that the solver's AlignmentResult can carry it without reaching into the estimator.
+// its covariance, the IMU model at the estimate and the chi-square consistency figures;
+// estimation/alignment_result.h puts it beside the pair solve as the window solve's answer.
 // Frames and units as estimation/joint_types.h states them (camera axes, IMU = accelerometer axes,
 // SI units).
 #pragma once
